@@ -1,0 +1,17 @@
+"""Renderer backends: everything that knows how a FURY version builds, reads and renders actors.
+
+The rest of the kit talks to a backend only through these functions:
+
+* ``build(scene) -> Drawing``: actors for every binding, with each target's reference geometry;
+* ``world_vertices(actor) -> (n, 3)``: what the renderer will draw, in world coordinates;
+* ``mesh_signature(actor)``: vertex count, topology and colours, to check a sync keeps the mesh;
+* ``render(drawing, camera, size) -> (h, w, 3) uint8``: an off-screen picture.
+
+FURY 0.12 (VTK) is the only backend today; FURY 2.x (pygfx) would be a sibling module.
+"""
+
+from __future__ import annotations
+
+from .vtk import Drawing, build, mesh_signature, render, world_vertices
+
+__all__ = ["Drawing", "build", "mesh_signature", "render", "world_vertices"]

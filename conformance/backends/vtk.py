@@ -1,0 +1,160 @@
+"""The FURY 0.12 / VTK 9.3 backend: build actors, read back what VTK draws, render off-screen.
+
+This is the only module that touches VTK objects on the kit's side (sync implementations under
+test, being FURY code, touch them too).
+"""
+
+from __future__ import annotations
+
+import hashlib
+from collections import defaultdict
+from dataclasses import dataclass
+from typing import Any, Sequence
+
+import numpy as np
+from vtkmodules.util import numpy_support
+
+from conformance import poses, truth
+from conformance.display import ensure_display
+from conformance.errors import SceneError
+from conformance.world import Target, World
+
+__all__ = ["Drawing", "build", "mesh_signature", "render", "world_vertices"]
+
+IDENTITY_POSITION = np.zeros(3)
+IDENTITY_ORIENTATION = np.array([0.0, 0.0, 0.0, 1.0])
+
+
+@dataclass(frozen=True, eq=False)
+class Drawing:
+    """A scene's actors, the :class:`World` handed to the sync, and the kit's reference geometry.
+
+    ``local[i]`` is target i's geometry in its link frame, float64, computed when the actor was built
+    (before any float32 storage): the ground truth that read-back is compared against.
+    """
+
+    world: World
+    local: tuple[np.ndarray, ...]
+
+    @property
+    def targets(self) -> tuple[Target, ...]:
+        return self.world.targets
+
+    @property
+    def actors(self):
+        return self.world.actors
+
+
+def _fury_actor(kind: str, shapes: Sequence[Any]):
+    """One FURY actor drawing ``shapes`` at the origin in their canonical direction."""
+    from fury import actor as fury_actor
+
+    n = len(shapes)
+    centers = np.zeros((n, 3))
+    colors = np.array([s.color for s in shapes], dtype=np.float64)
+    sizes = np.array([s.size for s in shapes], dtype=np.float64)
+    if kind == "box":
+        # FURY's unit box spans ±0.5 and keeps its axes for direction +x.
+        return fury_actor.box(centers=centers, directions=np.tile([1.0, 0, 0], (n, 1)), scales=2 * sizes, colors=colors)
+    if kind == "sphere":
+        return fury_actor.sphere(centers=centers, colors=colors, radii=sizes[:, 0])
+    # FURY scales its unit-height cylinder primitive *uniformly* by `heights`, so the drawn radius
+    # is radius × height: pass radius / height to draw the collision cylinder's own radius.
+    ratios = sizes[:, 0] / sizes[:, 1]
+    if not np.allclose(ratios, ratios[0], rtol=0, atol=1e-12):
+        raise SceneError("cylinders that share one FURY actor must have the same radius/height ratio")
+    return fury_actor.cylinder(centers=centers, directions=np.tile([0, 0, 1.0], (n, 1)), colors=colors,
+                               radius=float(ratios[0]), heights=sizes[:, 1], capped=True)
+
+
+def _points(actor) -> np.ndarray:
+    """The actor's vertex array as a writable numpy view."""
+    return numpy_support.vtk_to_numpy(actor.GetMapper().GetInput().GetPoints().GetData())
+
+
+def build(scene) -> Drawing:
+    """Actors for every binding of ``scene``, drawn at the poses pybullet holds now.
+
+    Whole actors are built at the origin with an identity transform (the guide: "Centers for the
+    actor must be set to (0, 0, 0)"); shared actors have each vertex range written at its body's
+    current link-frame pose (as the guide's single-actor example builds them from ``brick_centers``).
+    """
+    groups: dict[str, list[int]] = defaultdict(list)
+    for i, binding in enumerate(scene.bindings):
+        groups[binding.actor].append(i)
+    positions, orientations = truth.link_frames(scene.p, [(b.body, b.link) for b in scene.bindings])
+
+    actors: dict[str, Any] = {}
+    targets: list[Target | None] = [None] * len(scene.bindings)
+    local: list[np.ndarray | None] = [None] * len(scene.bindings)
+    for name, members in groups.items():
+        shapes = [scene.bindings[i].shape for i in members]
+        kinds = {s.kind for s in shapes}
+        if len(kinds) != 1:
+            raise SceneError(f"scene {scene.name!r}: actor {name!r} would draw several shape kinds {sorted(kinds)}")
+        actor = _fury_actor(kinds.pop(), shapes)
+        points = _points(actor)
+        per_body, remainder = divmod(len(points), len(members))
+        if remainder:
+            raise SceneError(f"scene {scene.name!r}: actor {name!r} has {len(points)} vertices for {len(members)} bodies")
+        shared = len(members) > 1
+        for k, i in enumerate(members):
+            start, stop = k * per_body, (k + 1) * per_body
+            shape = scene.bindings[i].shape
+            geometry = poses.apply(shape.position, shape.orientation, points[start:stop])
+            if shared:
+                drawn_pos, drawn_orn = positions[i], orientations[i]
+            else:
+                drawn_pos, drawn_orn = IDENTITY_POSITION, IDENTITY_ORIENTATION
+            points[start:stop] = poses.apply(drawn_pos, drawn_orn, geometry)
+            local[i] = geometry
+            targets[i] = Target(
+                name=scene.bindings[i].name, body=scene.bindings[i].body, link=scene.bindings[i].link,
+                actor=actor, start=start, stop=stop, shared=shared,
+                position=np.array(drawn_pos, dtype=np.float64), orientation=np.array(drawn_orn, dtype=np.float64),
+            )
+        actor.GetMapper().GetInput().GetPoints().Modified()
+        actor.GetMapper().GetInput().Modified()
+        actors[name] = actor
+
+    world = World(scene=scene.name, p=scene.p, targets=tuple(targets), actors=actors)
+    return Drawing(world=world, local=tuple(local))
+
+
+def world_vertices(actor) -> np.ndarray:
+    """The actor's vertices as VTK will draw them: polydata points through ``actor.GetMatrix()``,
+    which composes position, orientation, origin, scale, user matrix and user transform."""
+    points = np.asarray(_points(actor), dtype=np.float64)
+    matrix = np.array([[actor.GetMatrix().GetElement(r, c) for c in range(4)] for r in range(4)])
+    homogeneous = points @ matrix[:3, :3].T + matrix[:3, 3]
+    w = points @ matrix[3, :3] + matrix[3, 3]
+    return homogeneous / w[:, None]
+
+
+def mesh_signature(actor) -> tuple[int, str, str]:
+    """Vertex count and digests of the cells and vertex colours: what a sync must leave alone."""
+    data = actor.GetMapper().GetInput()
+    cells = hashlib.sha1()
+    for getter in (data.GetPolys, data.GetStrips, data.GetLines, data.GetVerts):
+        array = getter().GetData() if getter() is not None else None
+        if array is not None:
+            cells.update(numpy_support.vtk_to_numpy(array).tobytes())
+    colors = data.GetPointData().GetScalars()
+    color_digest = hashlib.sha1(numpy_support.vtk_to_numpy(colors).tobytes()).hexdigest() if colors is not None else ""
+    return data.GetNumberOfPoints(), cells.hexdigest(), color_digest
+
+
+def render(drawing: Drawing, camera, size: tuple[int, int], background=(1.0, 1.0, 1.0)) -> np.ndarray:
+    """An off-screen picture of the drawing, ``(height, width, 3)`` uint8, top row first."""
+    ensure_display()
+    from fury import window
+
+    stage = window.Scene()
+    stage.background(background)
+    for actor in drawing.actors.values():
+        stage.add(actor)
+    stage.set_camera(position=camera.position, focal_point=camera.focal_point, view_up=camera.view_up)
+    try:
+        return window.snapshot(stage, size=tuple(size), offscreen=True)
+    finally:
+        stage.clear()

@@ -1,0 +1,145 @@
+"""The command line: ``python -m conformance`` (or ``fury-conformance``).
+
+* ``run [--sync SPEC] [pytest args]``: the conformance checks, with a verdict per scene;
+* ``scenes``: the reference scenes and their parameters;
+* ``render SCENE [--step N] [--out PNG]``: a picture of a scene at a step, synced by a sync;
+* ``check SCENE [--sync SPEC] [--frames N] [--params JSON]``: replay one run frame by frame and
+  print each frame's worst error (what a failing check's "reproduce:" line runs).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from conformance.errors import ConformanceError
+
+__all__ = ["main"]
+
+
+def _params(text: str | None) -> dict:
+    if not text:
+        return {}
+    try:
+        value = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise ConformanceError(f"--params={text!r} is not JSON ({exc.msg}); write e.g. --params '{{\"rows\": 3}}'") from None
+    if not isinstance(value, dict):
+        raise ConformanceError(f"--params={text!r} is a JSON {type(value).__name__}, but should be an object of scene parameters")
+    return {k: tuple(v) if isinstance(v, list) else v for k, v in value.items()}
+
+
+def _cmd_run(args, extra: list[str]) -> int:
+    import pytest
+
+    from conformance.display import virtual_display
+
+    argv = ["--pyargs", "conformance", "-p", "no:cacheprovider", "--sync", args.sync, *extra]
+    with virtual_display():
+        return int(pytest.main(argv))
+
+
+def _cmd_scenes(args, extra) -> int:
+    from conformance import scenes
+
+    for name, spec in scenes.SCENES.items():
+        print(f"{name}  [{spec.origin}, {spec.steps} steps]  {spec.title}: {spec.description}")
+        if args.verbose:
+            for key, value in spec.defaults.items():
+                print(f"    {key} = {value!r}")
+    return 0
+
+
+def _cmd_render(args, extra) -> int:
+    from PIL import Image
+
+    from conformance import backends, runner, scenes, sync
+    from conformance.display import virtual_display
+
+    spec = scenes.get(args.scene)
+    step = spec.steps if args.step is None else args.step
+    out = Path(args.out or f"{args.scene}-step{step}.png")
+    with virtual_display(), runner.running(args.scene, sync.load(args.sync), **_params(args.params)) as run:
+        run.advance(step)
+        size = tuple(args.size) if args.size else run.scene.image_size
+        image = backends.render(run.drawing, run.scene.camera, size)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = out.with_name(out.name + ".tmp")
+    Image.fromarray(image).save(tmp, format="PNG")
+    tmp.replace(out)  # never leave a half-written picture under the final name
+    print(f"wrote {out} ({size[0]}x{size[1]}, scene {args.scene!r} at step {step}, sync {args.sync!r})")
+    return 0
+
+
+def _cmd_check(args, extra) -> int:
+    from conformance import compare, runner, scenes, sync
+
+    spec = scenes.get(args.scene)
+    frames = spec.steps if args.frames is None else args.frames
+    implementation = sync.load(args.sync)
+    worst_seen = None
+    with runner.running(args.scene, implementation, **_params(args.params)) as run:
+        for frame in range(frames + 1):
+            if frame:
+                run.advance()
+            results = compare.compare_vertices(run.drawing, frame)
+            bad = [r for r in results if not r.ok]
+            worst = max(results, key=lambda r: (r.error != r.error, r.error / r.tolerance if r.tolerance else r.error))
+            if bad or args.verbose:
+                print(f"frame {frame}: {len(bad)} of {len(results)} targets out of tolerance; worst: {worst.describe()}")
+            if bad and worst_seen is None:
+                worst_seen = worst
+    if worst_seen is None:
+        print(f"PASS {args.scene} with sync {args.sync!r}: every target within tolerance for frames 0..{frames}")
+        return 0
+    print(f"FAIL {args.scene} with sync {args.sync!r}: first failure at frame {worst_seen.frame}: {worst_seen.describe()}")
+    return 1
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="python -m conformance", description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    run = sub.add_parser("run", help="run the conformance checks (extra arguments go to pytest)")
+    run.add_argument("--sync", default=None, help="sync implementation (short name or module:attribute)")
+
+    listing = sub.add_parser("scenes", help="list the reference scenes")
+    listing.add_argument("-v", "--verbose", action="store_true", help="also list parameters and defaults")
+
+    render = sub.add_parser("render", help="render a scene at a step to a PNG")
+    render.add_argument("scene")
+    render.add_argument("--step", type=int, default=None, help="frames to run first (default: the scene's step count)")
+    render.add_argument("--sync", default="reference")
+    render.add_argument("--params", default=None, help="scene parameters as a JSON object")
+    render.add_argument("--size", type=int, nargs=2, metavar=("W", "H"), default=None)
+    render.add_argument("--out", default=None, help="PNG path (default: ./SCENE-stepN.png)")
+
+    check = sub.add_parser("check", help="replay a scene with a sync and print errors frame by frame")
+    check.add_argument("scene")
+    check.add_argument("--sync", default=None)
+    check.add_argument("--frames", type=int, default=None)
+    check.add_argument("--params", default=None, help="scene parameters as a JSON object")
+    check.add_argument("-v", "--verbose", action="store_true", help="print every frame, not only failing ones")
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    from conformance.sync import resolve_spec
+
+    args, extra = _parser().parse_known_args(argv)
+    if extra and args.command != "run":
+        _parser().error(f"unrecognized arguments: {' '.join(extra)}")
+    if hasattr(args, "sync"):
+        args.sync = resolve_spec(args.sync)
+    handler = {"run": _cmd_run, "scenes": _cmd_scenes, "render": _cmd_render, "check": _cmd_check}[args.command]
+    try:
+        return handler(args, extra)
+    except ConformanceError as err:
+        print(f"error: {err}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

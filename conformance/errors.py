@@ -1,0 +1,51 @@
+"""The kit's one exception tree.
+
+Every error the kit raises on purpose derives from :class:`ConformanceError`, so a caller can catch
+the kit's complaints without catching its own bugs. Messages are one paragraph: what was wrong, the
+value that was wrong, and what to do about it.
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "ConformanceError",
+    "DisplayUnavailable",
+    "InvalidArgument",
+    "SceneError",
+    "SyncError",
+    "SyncLoadError",
+    "SyncProtocolError",
+    "SyncRaised",
+]
+
+
+class ConformanceError(Exception):
+    """Base of every error the kit raises deliberately."""
+
+
+class InvalidArgument(ConformanceError, ValueError):
+    """A parameter given to the kit (a scene size, a step count, an option) is out of range."""
+
+
+class SceneError(ConformanceError):
+    """A reference scene cannot be built or described as asked."""
+
+
+class DisplayUnavailable(ConformanceError):
+    """No X display is set and none could be started for off-screen rendering."""
+
+
+class SyncError(ConformanceError):
+    """A sync implementation under test could not be used; the message names it."""
+
+
+class SyncLoadError(SyncError):
+    """The ``--sync`` spec does not name an importable object."""
+
+
+class SyncProtocolError(SyncError):
+    """The named object does not follow the sync protocol (see :mod:`conformance.sync`)."""
+
+
+class SyncRaised(SyncError):
+    """The sync implementation raised while the kit was running it."""

@@ -1,0 +1,257 @@
+"""What a reference scene is: physics in its own pybullet client, plus a description of how it is drawn.
+
+A scene knows physics and bindings and nothing of checks or of FURY: the backend builds actors from
+the :class:`Shape` of each :class:`Binding`. Scenes are objects built by a function from explicit
+parameters (no globals, every random draw seeded), own one DIRECT client and always disconnect it
+(:meth:`Scene.close`, or use the scene as a context manager).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Callable, Mapping, Sequence
+
+import numpy as np
+import pybullet
+
+from conformance.client import BoundClient
+from conformance.errors import InvalidArgument, SceneError
+
+__all__ = [
+    "Binding",
+    "Camera",
+    "ExternalForce",
+    "MovingPivot",
+    "Scene",
+    "Shape",
+    "IDENTITY",
+]
+
+IDENTITY = (0.0, 0.0, 0.0, 1.0)
+SHAPE_KINDS = ("box", "sphere", "cylinder")
+
+
+@dataclass(frozen=True)
+class Shape:
+    """A collision shape and the way it is drawn (the same thing, by construction).
+
+    ``size`` is ``(hx, hy, hz)`` half extents for a box, ``(radius,)`` for a sphere and
+    ``(radius, height)`` for a cylinder along the local z axis (pybullet's convention). ``position``
+    and ``orientation`` place the shape in its body's link frame (pybullet's
+    ``collisionFramePosition``/``collisionFrameOrientation``).
+    """
+
+    kind: str
+    size: tuple[float, ...]
+    color: tuple[float, float, float] = (0.8, 0.8, 0.8)
+    position: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    orientation: tuple[float, float, float, float] = IDENTITY
+
+    def __post_init__(self):
+        expected = {"box": 3, "sphere": 1, "cylinder": 2}.get(self.kind)
+        if expected is None:
+            raise InvalidArgument(f"kind={self.kind!r} ({type(self.kind).__name__}), but should be one of {SHAPE_KINDS}")
+        if len(self.size) != expected or not all(math.isfinite(s) and s > 0 for s in self.size):
+            raise InvalidArgument(
+                f"size={self.size!r} for a {self.kind}, but should be {expected} finite positive numbers"
+            )
+
+    def collision_shape(self, p: BoundClient) -> int:
+        """Create this shape in pybullet and return its collision shape index."""
+        frame = dict(collisionFramePosition=list(self.position), collisionFrameOrientation=list(self.orientation))
+        if self.kind == "box":
+            return p.createCollisionShape(pybullet.GEOM_BOX, halfExtents=list(self.size), **frame)
+        if self.kind == "sphere":
+            return p.createCollisionShape(pybullet.GEOM_SPHERE, radius=self.size[0], **frame)
+        return p.createCollisionShape(pybullet.GEOM_CYLINDER, radius=self.size[0], height=self.size[1], **frame)
+
+
+@dataclass(frozen=True)
+class Binding:
+    """One drawn thing: body ``body`` (link ``link``, -1 for the base) is drawn by actor ``actor``.
+
+    Bindings that name the same ``actor`` are drawn by one shared FURY actor (the guide's "rendering
+    multiple objects by a single actor"), each by its own vertex range, in binding order; they must
+    have the same shape kind. A binding alone in its actor is drawn by a whole actor.
+    """
+
+    name: str
+    body: int
+    link: int
+    actor: str
+    shape: Shape
+
+
+@dataclass(frozen=True)
+class Camera:
+    position: tuple[float, float, float]
+    focal_point: tuple[float, float, float]
+    view_up: tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class ExternalForce:
+    """``applyExternalForce`` before the steps in ``steps`` (the guide's one-shot pushes).
+
+    ``offset`` is added to the body's current centre of mass to give ``posObj`` in WORLD_FRAME,
+    as the guide does with ``posObj=ball_pos``.
+    """
+
+    body: int
+    force: tuple[float, float, float]
+    steps: tuple[int, ...] = (0,)
+    link: int = -1
+    offset: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+    def apply(self, p: BoundClient, step: int, dt: float) -> None:
+        if step not in self.steps:
+            return
+        if self.link == -1:
+            centre = p.getBasePositionAndOrientation(self.body)[0]
+        else:
+            centre = p.getLinkState(self.body, self.link, computeForwardKinematics=1)[0]
+        position = [c + o for c, o in zip(centre, self.offset)]
+        p.applyExternalForce(self.body, self.link, forceObj=list(self.force), posObj=position, flags=pybullet.WORLD_FRAME)
+
+
+@dataclass(frozen=True)
+class MovingPivot:
+    """Before every step, move a fixed constraint's pivot to ``centre + amplitude * sin(2π f t)``
+    (the chain example's trajectory; t is the time after the step, as in the example)."""
+
+    constraint: int
+    centre: tuple[float, float, float]
+    amplitude: tuple[float, float, float]
+    frequency: float
+    max_force: float
+
+    def apply(self, p: BoundClient, step: int, dt: float) -> None:
+        s = math.sin(2 * math.pi * self.frequency * (step + 1) * dt)
+        pivot = [c + a * s for c, a in zip(self.centre, self.amplitude)]
+        p.changeConstraint(self.constraint, pivot, jointChildFrameOrientation=list(IDENTITY), maxForce=self.max_force)
+
+
+@dataclass
+class Scene:
+    """A reference scene: a live pybullet DIRECT client and what to draw.
+
+    Create it with a scene builder (``scenes.build(name, **params)``); the constructor only connects.
+    """
+
+    name: str
+    params: Mapping[str, Any]
+    camera: Camera
+    image_size: tuple[int, int] = (450, 384)
+    steps: int = 120
+    dt: float = 1.0 / 240.0
+    description: str = ""
+    bindings: list[Binding] = field(default_factory=list)
+    actions: list[Any] = field(default_factory=list)
+    client: int = field(init=False, default=-1)
+
+    def __post_init__(self):
+        self.client = pybullet.connect(pybullet.DIRECT)
+        if self.client < 0:
+            raise SceneError(f"scene {self.name!r}: pybullet.connect(DIRECT) failed (returned {self.client})")
+        self.p = BoundClient(self.client)
+        self.p.setTimeStep(self.dt)
+
+    # -- building -------------------------------------------------------------------------------
+    def add_body(
+        self,
+        name: str,
+        shape: Shape,
+        *,
+        mass: float,
+        position: Sequence[float],
+        orientation: Sequence[float] = IDENTITY,
+        actor: str | None = None,
+        friction: float | None = None,
+        restitution: float | None = None,
+    ) -> int:
+        """Create a single-link body whose collision shape is ``shape`` and bind it for drawing."""
+        body = self.p.createMultiBody(
+            baseMass=mass,
+            baseCollisionShapeIndex=shape.collision_shape(self.p),
+            basePosition=list(position),
+            baseOrientation=list(orientation),
+        )
+        dynamics = {}
+        if friction is not None:
+            dynamics["lateralFriction"] = friction
+        if restitution is not None:
+            dynamics["restitution"] = restitution
+        if dynamics:
+            self.p.changeDynamics(body, -1, **dynamics)
+        self.bind(name, body, -1, shape, actor=actor)
+        return body
+
+    def bind(self, name: str, body: int, link: int, shape: Shape, *, actor: str | None = None) -> Binding:
+        binding = Binding(name=name, body=body, link=link, actor=actor or name, shape=shape)
+        self.bindings.append(binding)
+        return binding
+
+    # -- running --------------------------------------------------------------------------------
+    def act(self, step: int) -> None:
+        """Apply this scene's actions that belong before ``stepSimulation`` number ``step`` (0-based)."""
+        for action in self.actions:
+            action.apply(self.p, step, self.dt)
+
+    def advance(self, step: int) -> None:
+        """One frame of the scene: its actions for ``step``, then one ``stepSimulation``."""
+        self.act(step)
+        self.p.stepSimulation()
+
+    def run(self, steps: int, on_step: Callable[[int], None] | None = None) -> None:
+        """Advance ``steps`` frames from the current state, calling ``on_step(n)`` after frame n (1-based)."""
+        for step in range(steps):
+            self.advance(step)
+            if on_step is not None:
+                on_step(step + 1)
+
+    def poses(self) -> np.ndarray:
+        """Centre-of-mass pose of every binding, ``(n, 7)`` float64 = position + quaternion (x, y, z, w)."""
+        rows = []
+        for b in self.bindings:
+            if b.link == -1:
+                pos, orn = self.p.getBasePositionAndOrientation(b.body)
+            else:
+                pos, orn = self.p.getLinkState(b.body, b.link, computeForwardKinematics=1)[:2]
+            rows.append((*pos, *orn))
+        return np.asarray(rows, dtype=np.float64).reshape(-1, 7)
+
+    def velocities(self) -> np.ndarray:
+        """Linear and angular velocity of every binding, ``(n, 6)`` float64."""
+        rows = []
+        for b in self.bindings:
+            if b.link == -1:
+                lin, ang = self.p.getBaseVelocity(b.body)
+            else:
+                lin, ang = self.p.getLinkState(b.body, b.link, computeLinkVelocity=1, computeForwardKinematics=1)[6:8]
+            rows.append((*lin, *ang))
+        return np.asarray(rows, dtype=np.float64).reshape(-1, 6)
+
+    def reproduce(self) -> str:
+        """A Python expression that rebuilds this scene."""
+        args = ", ".join(f"{k}={v!r}" for k, v in self.params.items())
+        return f"scenes.build({self.name!r}{', ' + args if args else ''})"
+
+    # -- lifetime -------------------------------------------------------------------------------
+    @property
+    def connected(self) -> bool:
+        return self.client >= 0 and bool(pybullet.isConnected(physicsClientId=self.client))
+
+    def close(self) -> None:
+        """Disconnect the client; safe to call more than once."""
+        if self.connected:
+            pybullet.disconnect(physicsClientId=self.client)
+
+    def __enter__(self) -> "Scene":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def __repr__(self) -> str:
+        return f"<Scene {self.reproduce()} client={self.client} bindings={len(self.bindings)}>"
