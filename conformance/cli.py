@@ -53,15 +53,27 @@ def _cmd_scenes(args, extra) -> int:
 
 
 def _cmd_render(args, extra) -> int:
+    from conformance import scenes
+    from conformance.display import virtual_display
+
+    names = scenes.names() if args.scene == ["all"] else args.scene
+    if args.out and len(names) > 1:
+        raise ConformanceError("--out names one file; with several scenes use --out-dir")
+    with virtual_display():
+        for name in names:
+            _render_one(name, args)
+    return 0
+
+
+def _render_one(name: str, args) -> None:
     from PIL import Image
 
     from conformance import backends, runner, scenes, sync
-    from conformance.display import virtual_display
 
-    spec = scenes.get(args.scene)
-    step = spec.steps if args.step is None else args.step
-    out = Path(args.out or f"{args.scene}-step{step}.png")
-    with virtual_display(), runner.running(args.scene, sync.load(args.sync), **_params(args.params)) as run:
+    spec = scenes.get(name)
+    step = (spec.poster_step or spec.steps) if args.step is None else args.step
+    out = Path(args.out or Path(args.out_dir) / f"{name}-step{step}.png")
+    with runner.running(name, sync.load(args.sync), **_params(args.params)) as run:
         run.advance(step)
         size = tuple(args.size) if args.size else run.scene.image_size
         image = backends.render(run.drawing, run.scene.camera, size)
@@ -69,8 +81,7 @@ def _cmd_render(args, extra) -> int:
     tmp = out.with_name(out.name + ".tmp")
     Image.fromarray(image).save(tmp, format="PNG")
     tmp.replace(out)  # never leave a half-written picture under the final name
-    print(f"wrote {out} ({size[0]}x{size[1]}, scene {args.scene!r} at step {step}, sync {args.sync!r})")
-    return 0
+    print(f"wrote {out} ({size[0]}x{size[1]}, scene {name!r} at step {step}, sync {args.sync!r})")
 
 
 def _cmd_check(args, extra) -> int:
@@ -108,13 +119,14 @@ def _parser() -> argparse.ArgumentParser:
     listing = sub.add_parser("scenes", help="list the reference scenes")
     listing.add_argument("-v", "--verbose", action="store_true", help="also list parameters and defaults")
 
-    render = sub.add_parser("render", help="render a scene at a step to a PNG")
-    render.add_argument("scene")
-    render.add_argument("--step", type=int, default=None, help="frames to run first (default: the scene's step count)")
+    render = sub.add_parser("render", help="render scenes at a step to PNGs")
+    render.add_argument("scene", nargs="+", help="scene names, or 'all'")
+    render.add_argument("--step", type=int, default=None, help="frames to run first (default: the scene's poster frame)")
     render.add_argument("--sync", default="reference")
     render.add_argument("--params", default=None, help="scene parameters as a JSON object")
     render.add_argument("--size", type=int, nargs=2, metavar=("W", "H"), default=None)
-    render.add_argument("--out", default=None, help="PNG path (default: ./SCENE-stepN.png)")
+    render.add_argument("--out", default=None, help="PNG path for one scene (default: OUT_DIR/SCENE-stepN.png)")
+    render.add_argument("--out-dir", default=".", help="directory for the PNGs (default: the current directory)")
 
     check = sub.add_parser("check", help="replay a scene with a sync and print errors frame by frame")
     check.add_argument("scene")

@@ -15,7 +15,17 @@ __all__ = ["SCENES", "SceneSpec", "build", "get", "names", "register"]
 
 # One module per scene; order is the order of reports and of the README.
 _MODULES = (
+    "ball_collision",
+    "brick_wall",
+    "brick_wall_single",
+    "chain",
+    "wrecking_ball",
+    "domino",
     "free_fall",
+    "sliding_box",
+    "bouncing_ball",
+    "pendulum",
+    "mixed_shapes",
 )
 
 
@@ -38,6 +48,7 @@ class SceneSpec:
     image_size: tuple[int, int] = (450, 384)
     parameters: Callable[[], Any] | None = None
     gravity: tuple[float, float, float] = (0.0, 0.0, -10.0)
+    poster_step: int | None = None  # the frame that shows the scene best (README thumbnails); else `steps`
     defaults: Mapping[str, Any] = field(init=False)
 
     def __post_init__(self):

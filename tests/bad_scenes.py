@@ -31,7 +31,7 @@ def hash_ordered(scene, *, count: int = 3) -> None:
     # str hashes are salted per process (PYTHONHASHSEED), so this is stable within a process only.
     names = sorted({"alpha", "beta", "gamma"}, key=hash)[:count]
     for i, name in enumerate(names):
-        _ball(scene, position=(0.5 * i + 0.001 * len(name), 0, 1.0))
+        _ball(scene, position=(0.5 * i + 0.01 * (ord(name[0]) - 96), 0, 1.0))
 
 
 def leaky(scene, *, count: int = 1) -> None:

@@ -31,10 +31,13 @@ class Drawing:
 
     ``local[i]`` is target i's geometry in its link frame, float64, computed when the actor was built
     (before any float32 storage): the ground truth that read-back is compared against.
+    ``local_normals[i]`` are its vertex normals in the link frame, or None where FURY stores none
+    (boxes, cylinders: VTK derives their normals from the faces).
     """
 
     world: World
     local: tuple[np.ndarray, ...]
+    local_normals: tuple[np.ndarray | None, ...]
 
     @property
     def targets(self) -> tuple[Target, ...]:
@@ -64,12 +67,18 @@ def _fury_actor(kind: str, shapes: Sequence[Any]):
     if not np.allclose(ratios, ratios[0], rtol=0, atol=1e-12):
         raise SceneError("cylinders that share one FURY actor must have the same radius/height ratio")
     return fury_actor.cylinder(centers=centers, directions=np.tile([0, 0, 1.0], (n, 1)), colors=colors,
-                               radius=float(ratios[0]), heights=sizes[:, 1], capped=True)
+                               radius=float(ratios[0]), heights=sizes[:, 1], capped=True, resolution=16)
 
 
 def _points(actor) -> np.ndarray:
     """The actor's vertex array as a writable numpy view."""
     return numpy_support.vtk_to_numpy(actor.GetMapper().GetInput().GetPoints().GetData())
+
+
+def _normals(actor) -> np.ndarray | None:
+    """The actor's stored vertex normals as a writable numpy view, or None."""
+    normals = actor.GetMapper().GetInput().GetPointData().GetNormals()
+    return None if normals is None else numpy_support.vtk_to_numpy(normals)
 
 
 def build(scene) -> Drawing:
@@ -87,6 +96,7 @@ def build(scene) -> Drawing:
     actors: dict[str, Any] = {}
     targets: list[Target | None] = [None] * len(scene.bindings)
     local: list[np.ndarray | None] = [None] * len(scene.bindings)
+    local_normals: list[np.ndarray | None] = [None] * len(scene.bindings)
     for name, members in groups.items():
         shapes = [scene.bindings[i].shape for i in members]
         kinds = {s.kind for s in shapes}
@@ -94,6 +104,7 @@ def build(scene) -> Drawing:
             raise SceneError(f"scene {scene.name!r}: actor {name!r} would draw several shape kinds {sorted(kinds)}")
         actor = _fury_actor(kinds.pop(), shapes)
         points = _points(actor)
+        normals = _normals(actor)
         per_body, remainder = divmod(len(points), len(members))
         if remainder:
             raise SceneError(f"scene {scene.name!r}: actor {name!r} has {len(points)} vertices for {len(members)} bodies")
@@ -108,17 +119,23 @@ def build(scene) -> Drawing:
                 drawn_pos, drawn_orn = IDENTITY_POSITION, IDENTITY_ORIENTATION
             points[start:stop] = poses.apply(drawn_pos, drawn_orn, geometry)
             local[i] = geometry
+            if normals is not None:
+                # Normals turn with the body, or a rotated sphere is shaded as if lit from elsewhere.
+                local_normals[i] = np.asarray(normals[start:stop], dtype=np.float64) @ poses.matrices(shape.orientation).T
+                normals[start:stop] = local_normals[i] @ poses.matrices(drawn_orn).T
             targets[i] = Target(
                 name=scene.bindings[i].name, body=scene.bindings[i].body, link=scene.bindings[i].link,
                 actor=actor, start=start, stop=stop, shared=shared,
                 position=np.array(drawn_pos, dtype=np.float64), orientation=np.array(drawn_orn, dtype=np.float64),
             )
         actor.GetMapper().GetInput().GetPoints().Modified()
+        if normals is not None:
+            actor.GetMapper().GetInput().GetPointData().GetNormals().Modified()
         actor.GetMapper().GetInput().Modified()
         actors[name] = actor
 
     world = World(scene=scene.name, p=scene.p, targets=tuple(targets), actors=actors)
-    return Drawing(world=world, local=tuple(local))
+    return Drawing(world=world, local=tuple(local), local_normals=tuple(local_normals))
 
 
 def world_vertices(actor) -> np.ndarray:

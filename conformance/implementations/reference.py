@@ -24,6 +24,11 @@ def _points(actor) -> np.ndarray:
     return numpy_support.vtk_to_numpy(actor.GetMapper().GetInput().GetPoints().GetData())
 
 
+def _normals(actor) -> np.ndarray | None:
+    normals = actor.GetMapper().GetInput().GetPointData().GetNormals()
+    return None if normals is None else numpy_support.vtk_to_numpy(normals)
+
+
 class ReferenceSync:
     """Exact, vectorised sync: world vertices = pybullet link-frame pose × geometry captured at set-up."""
 
@@ -43,7 +48,7 @@ class ReferenceSync:
                 links[t.body].append(t.link)
         self._links = {body: sorted(set(ids)) for body, ids in links.items()}
         # Geometry in the link frame, recovered once from the vertices as drawn at set-up.
-        self._shared: dict[int, tuple[object, list[int], np.ndarray]] = {}
+        self._shared: dict[int, tuple[object, list[int], np.ndarray, np.ndarray | None]] = {}
         self._whole: list[tuple[int, object]] = []
         by_actor = defaultdict(list)
         for i, t in enumerate(self.targets):
@@ -59,7 +64,13 @@ class ReferenceSync:
                     points[self.targets[i].start:self.targets[i].stop] - self.targets[i].position)
                 for i in members
             ])
-            self._shared[id(actor)] = (actor, members, local)
+            normals = _normals(actor)
+            local_normals = None if normals is None else np.stack([
+                np.asarray(normals[self.targets[i].start:self.targets[i].stop], dtype=np.float64)
+                @ Rotation.from_quat(self.targets[i].orientation).as_matrix()  # row vectors: × R = R⁻¹ applied
+                for i in members
+            ])
+            self._shared[id(actor)] = (actor, members, local, local_normals)
 
     def _poses(self) -> tuple[np.ndarray, np.ndarray]:
         link_poses = {}
@@ -83,12 +94,18 @@ class ReferenceSync:
 
     def __call__(self) -> None:
         positions, matrices = self._poses()
-        for actor, members, local in self._shared.values():
+        for actor, members, local, local_normals in self._shared.values():
             moved = np.einsum("nij,nkj->nki", matrices[members], local) + positions[members][:, None, :]
             points = _points(actor)
             for k, i in enumerate(members):
                 points[self.targets[i].start:self.targets[i].stop] = moved[k]
             actor.GetMapper().GetInput().GetPoints().Modified()
+            if local_normals is not None:
+                turned = np.einsum("nij,nkj->nki", matrices[members], local_normals)
+                normals = _normals(actor)
+                for k, i in enumerate(members):
+                    normals[self.targets[i].start:self.targets[i].stop] = turned[k]
+                actor.GetMapper().GetInput().GetPointData().GetNormals().Modified()
         for i, actor in self._whole:
             matrix = np.eye(4)
             matrix[:3, :3], matrix[:3, 3] = matrices[i], positions[i]
