@@ -85,27 +85,31 @@ def _render_one(name: str, args) -> None:
 
 
 def _cmd_check(args, extra) -> int:
-    from conformance import compare, runner, scenes, sync
+    from conformance import compare, events, runner, scenes, sync
 
     spec = scenes.get(args.scene)
     frames = spec.steps if args.frames is None else args.frames
     implementation = sync.load(args.sync)
-    worst_seen = None
-    with runner.running(args.scene, implementation, **_params(args.params)) as run:
+    first_failure = None
+    with runner.running(args.scene, implementation, events=events.loads(args.events or "[]"), **_params(args.params)) as run:
         for frame in range(frames + 1):
             if frame:
                 run.advance()
             results = compare.compare_vertices(run.drawing, frame)
-            bad = [r for r in results if not r.ok]
+            problems = [r.describe() for r in results if not r.ok]
+            problems += [r.describe() for r in compare.compare_normals(run.drawing, frame) if not r.ok]
+            problems += [f"actor {name!r} changed without Modified()" for f, name in run.unannounced if f == frame]
             worst = max(results, key=lambda r: (r.error != r.error, r.error / r.tolerance if r.tolerance else r.error))
-            if bad or args.verbose:
-                print(f"frame {frame}: {len(bad)} of {len(results)} targets out of tolerance; worst: {worst.describe()}")
-            if bad and worst_seen is None:
-                worst_seen = worst
-    if worst_seen is None:
+            if problems or args.verbose:
+                print(f"frame {frame}: {len(problems)} problems; worst vertex: {worst.describe()}")
+                for line in problems[:5]:
+                    print(f"    {line}")
+            if problems and first_failure is None:
+                first_failure = (frame, problems[0])
+    if first_failure is None:
         print(f"PASS {args.scene} with sync {args.sync!r}: every target within tolerance for frames 0..{frames}")
         return 0
-    print(f"FAIL {args.scene} with sync {args.sync!r}: first failure at frame {worst_seen.frame}: {worst_seen.describe()}")
+    print(f"FAIL {args.scene} with sync {args.sync!r}: first failure at frame {first_failure[0]}: {first_failure[1]}")
     return 1
 
 
@@ -133,6 +137,7 @@ def _parser() -> argparse.ArgumentParser:
     check.add_argument("--sync", default=None)
     check.add_argument("--frames", type=int, default=None)
     check.add_argument("--params", default=None, help="scene parameters as a JSON object")
+    check.add_argument("--events", default=None, help="teleports, joint resets and kicks as JSON (from a failure)")
     check.add_argument("-v", "--verbose", action="store_true", help="print every frame, not only failing ones")
     return parser
 

@@ -9,12 +9,22 @@ from dataclasses import dataclass
 from typing import Sequence
 
 import numpy as np
+import pybullet
 
-from conformance import backends, shapes, truth
+from conformance import backends, poses, shapes, truth
 from conformance.backends import Drawing
 from conformance.tolerances import DEFAULT, Tolerance
 
-__all__ = ["GeometryResult", "VertexResult", "compare_collision_geometry", "compare_vertices"]
+__all__ = [
+    "BoundsResult",
+    "GeometryResult",
+    "NormalResult",
+    "VertexResult",
+    "compare_bounds",
+    "compare_collision_geometry",
+    "compare_normals",
+    "compare_vertices",
+]
 
 
 @dataclass(frozen=True)
@@ -56,13 +66,14 @@ def compare_vertices(drawing: Drawing, frame: int, tolerance: Tolerance = DEFAUL
     """One record per target: the worst vertex of what the renderer draws vs pybullet's pose."""
     targets = drawing.targets
     positions, orientations = truth.link_frames(drawing.world.p, [(t.body, t.link) for t in targets])
+    rotations = poses.matrices(orientations)
     drawn = {}
     results = []
     for i, t in enumerate(targets):
         if id(t.actor) not in drawn:
             drawn[id(t.actor)] = backends.world_vertices(t.actor)
         actual = drawn[id(t.actor)][t.start:t.stop]
-        expected = truth.expected_vertices(drawing.local[i], positions[i], orientations[i])
+        expected = drawing.local[i] @ rotations[i].T + positions[i]
         errors = np.linalg.norm(actual - expected, axis=1)
         errors = np.where(np.isfinite(errors), errors, np.inf)
         worst = int(np.argmax(errors)) if len(errors) else 0
@@ -117,4 +128,96 @@ def compare_collision_geometry(drawing: Drawing, frame: int, tolerance: Toleranc
         tol = tolerance.for_geometry(drawing.local[i], shape_pos)
         results.append(GeometryResult(drawing.world.scene, t.name, shapes.kind_name(geometry),
                                       tuple(shapes.problems(geometry, dimensions, in_shape, tol))))
+    return results
+
+
+@dataclass(frozen=True)
+class NormalResult:
+    """The worst vertex normal of one target: the angle between how it is lit and how it should be."""
+
+    scene: str
+    target: str
+    frame: int
+    angle: float
+    tolerance: float
+    vertex: int
+
+    @property
+    def ok(self) -> bool:
+        return self.angle <= self.tolerance
+
+    def describe(self) -> str:
+        return (f"{self.target!r} vertex {self.vertex} normal is turned {self.angle:.3g} rad from the body's "
+                f"rotated normal, but should be within {self.tolerance:.3g} rad (lighting would be wrong)")
+
+
+def compare_normals(drawing: Drawing, frame: int, tolerance: Tolerance = DEFAULT) -> list[NormalResult]:
+    """Targets whose actor stores vertex normals: they must turn with the body."""
+    results = []
+    _, orientations = truth.link_frames(drawing.world.p, [(t.body, t.link) for t in drawing.targets])
+    lit = {}
+    for i, t in enumerate(drawing.targets):
+        if drawing.local_normals[i] is None:
+            continue
+        if id(t.actor) not in lit:
+            lit[id(t.actor)] = backends.world_normals(t.actor)
+        actual = lit[id(t.actor)]
+        if actual is None:
+            results.append(NormalResult(drawing.world.scene, t.name, frame, float("inf"), tolerance.normal_angle, 0))
+            continue
+        expected = truth.expected_vertices(drawing.local_normals[i], np.zeros(3), orientations[i])
+        cosines = np.einsum("ij,ij->i", actual[t.start:t.stop], expected / np.linalg.norm(expected, axis=1, keepdims=True))
+        angles = np.arccos(np.clip(np.nan_to_num(cosines, nan=-1.0), -1.0, 1.0))
+        worst = int(np.argmax(angles))
+        results.append(NormalResult(drawing.world.scene, t.name, frame, float(angles[worst]), tolerance.normal_angle, worst))
+    return results
+
+
+@dataclass(frozen=True)
+class BoundsResult:
+    """A target's drawn world bounding box against pybullet's ``getAABB``."""
+
+    scene: str
+    target: str
+    frame: int
+    problems: tuple[str, ...]
+
+    @property
+    def ok(self) -> bool:
+        return not self.problems
+
+
+def compare_bounds(drawing: Drawing, frame: int, tolerance: Tolerance = DEFAULT) -> list[BoundsResult]:
+    """Each target's drawn box lies inside ``getAABB`` and reaches it on every side within the margin
+    stated in :mod:`conformance.tolerances`."""
+    p = drawing.world.p
+    drawn = {}
+    positions, _ = truth.link_frames(p, [(t.body, t.link) for t in drawing.targets])
+    results = []
+    for i, t in enumerate(drawing.targets):
+        if id(t.actor) not in drawn:
+            drawn[id(t.actor)] = backends.world_vertices(t.actor)
+        vertices = drawn[id(t.actor)][t.start:t.stop]
+        low, high = (np.asarray(v, dtype=np.float64) for v in p.getAABB(t.body, t.link))
+        shape = drawing.world.p.getCollisionShapeData(t.body, t.link)[0]
+        size = float(np.max(np.linalg.norm(drawing.local[i] - drawing.local[i].mean(axis=0), axis=1)))
+        loose = shape[2] == pybullet.GEOM_CYLINDER or not np.allclose(np.abs(shape[6][3]), 1.0)
+        rtol = tolerance.loose_bounds_rtol if loose else tolerance.bounds_rtol
+        slack = tolerance.for_geometry(drawing.local[i], positions[i])
+        margin = rtol * size + slack
+        found = []
+        if not np.isfinite(vertices).all():
+            found.append("drawn vertices are not finite")
+        else:
+            v_low, v_high = vertices.min(axis=0), vertices.max(axis=0)
+            outside = np.maximum(low - v_low, v_high - high)
+            short = np.maximum(v_low - low, high - v_high)
+            for axis in range(3):
+                if outside[axis] > slack:
+                    found.append(f"drawn box sticks out of getAABB by {outside[axis]:.3g} m along {'xyz'[axis]} "
+                                 f"(tolerance {slack:.3g} m)")
+                elif short[axis] > margin:
+                    found.append(f"drawn box falls {short[axis]:.3g} m short of getAABB along {'xyz'[axis]} "
+                                 f"(margin {margin:.3g} m)")
+        results.append(BoundsResult(drawing.world.scene, t.name, frame, tuple(found)))
     return results

@@ -4,6 +4,11 @@ Options live under one group, each mirrored by an ini setting:
 
 * ``--sync SPEC`` / ``conformance_sync``: the implementation under test, a short name or
   ``module:attribute``; ``$CONFORMANCE_SYNC`` when neither is given; ``reference`` by default.
+* ``--conformance-size-rtol``, ``--conformance-position-rtol``, ``--conformance-atol``,
+  ``--conformance-normal-angle`` (and ``conformance_size_rtol`` … in the ini file): the tolerances
+  of :mod:`conformance.tolerances`.
+* ``--conformance-report PATH`` / ``conformance_report``: write every check's outcome, scene and
+  worst measured error as JSON (what ``python -m conformance verdicts`` reads).
 
 Loading this plugin is cheap: it imports pybullet, VTK and the sync only when a conformance check
 is collected, so it stays out of the way of unrelated test suites in the same environment.
@@ -11,6 +16,7 @@ is collected, so it stays out of the way of unrelated test suites in the same en
 
 from __future__ import annotations
 
+import dataclasses
 from collections import defaultdict
 
 import pytest
@@ -20,6 +26,7 @@ from conformance import profiles
 SYNC_OPTION = "--sync"
 _SYNC_KEY = pytest.StashKey["object"]()
 _VERDICT_KEY = pytest.StashKey[dict]()
+_RECORDS_KEY = pytest.StashKey[list]()
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:
@@ -33,6 +40,44 @@ def pytest_addoption(parser: pytest.Parser) -> None:
         "guide-joint) or module:attribute. Default: ini conformance_sync, else $CONFORMANCE_SYNC, else reference.",
     )
     parser.addini("conformance_sync", "default for --sync", default=None)
+    for name, help_text in _TOLERANCE_OPTIONS.items():
+        group.addoption(f"--conformance-{name.replace('_', '-')}", dest=f"conformance_{name}", type=float,
+                        default=None, metavar="X", help=help_text)
+        parser.addini(f"conformance_{name}", help_text, default=None)
+    group.addoption("--conformance-report", dest="conformance_report", metavar="PATH", default=None,
+                    help="write each check's outcome, scene and worst error as JSON to PATH")
+    parser.addini("conformance_report", "default for --conformance-report", default=None)
+
+
+_TOLERANCE_OPTIONS = {
+    "size_rtol": "vertex tolerance per metre of body size (default 1e-5)",
+    "position_rtol": "vertex tolerance per metre of distance from the origin (default 2.4e-7)",
+    "atol": "absolute vertex tolerance in metres (default 1e-9)",
+    "normal_angle": "largest angle in radians between a drawn and an expected vertex normal (default 1e-4)",
+}
+
+
+def _option(config: pytest.Config, name: str):
+    value = config.getoption(f"conformance_{name}")
+    return value if value is not None else config.getini(f"conformance_{name}")
+
+
+def tolerance_from(config: pytest.Config):
+    from conformance.tolerances import DEFAULT
+
+    values = {}
+    for name in _TOLERANCE_OPTIONS:
+        raw = _option(config, name)
+        if raw in (None, ""):
+            continue
+        try:
+            value = float(raw)
+        except ValueError:
+            raise pytest.UsageError(f"conformance_{name}={raw!r} ({type(raw).__name__}), but should be a number") from None
+        if not value >= 0:
+            raise pytest.UsageError(f"conformance_{name}={raw!r}, but should be a non-negative number")
+        values[name] = value
+    return dataclasses.replace(DEFAULT, **values)
 
 
 def _sync_spec(config: pytest.Config) -> str:
@@ -43,6 +88,7 @@ def _sync_spec(config: pytest.Config) -> str:
 
 def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line("markers", "scene(name): the reference scene a conformance check runs on")
+    config.addinivalue_line("markers", "sync: a check that runs the sync implementation under test (added automatically)")
     config.stash[_VERDICT_KEY] = defaultdict(lambda: defaultdict(list))
 
 
@@ -62,14 +108,18 @@ def pytest_report_header(config: pytest.Config) -> list[str]:
         except md.PackageNotFoundError:
             versions.append(f"{dist} missing")
     return [
-        f"conformance: sync {_sync_spec(config)!r}; {profiles.describe()}",
+        f"conformance: sync {_sync_spec(config)!r}; {profiles.describe()}; tolerance {tolerance_from(config).describe()}",
         "conformance: " + ", ".join(versions),
     ]
 
 
 def pytest_collection_modifyitems(session: pytest.Session, config: pytest.Config, items) -> None:
-    """Load the sync under test once, before any check runs, if any collected check needs it."""
-    if not any("sync_implementation" in getattr(item, "fixturenames", ()) for item in items):
+    """Mark the checks that run the sync under test (``-m sync`` selects them) and load the sync once,
+    before any check runs, if any collected check needs it."""
+    uses_sync = [item for item in items if "sync_implementation" in getattr(item, "fixturenames", ())]
+    for item in uses_sync:
+        item.add_marker(pytest.mark.sync)
+    if not uses_sync:
         return
     from conformance.errors import SyncError
     from conformance.sync import load
@@ -93,13 +143,51 @@ def sync_implementation(request: pytest.FixtureRequest):
         return implementation
 
 
+@pytest.fixture
+def kit(request: pytest.FixtureRequest, sync_implementation):
+    """The sync under test, the tolerances in force, and a recorder for this check's worst error."""
+    from conformance.pytest_helpers import Kit
+
+    return Kit(sync_implementation, tolerance_from(request.config), request.node)
+
+
 @pytest.hookimpl(wrapper=True)
 def pytest_runtest_makereport(item: pytest.Item, call):
     report = yield
     marker = item.get_closest_marker("scene")
     if marker is not None and (report.when == "call" or report.outcome != "passed"):
         item.config.stash[_VERDICT_KEY][marker.args[0]][report.outcome].append(item.name)
+    if report.when == "call" or report.outcome != "passed":
+        from conformance.pytest_helpers import WORST
+
+        message = ""
+        if report.failed and report.longrepr is not None:
+            message = str(getattr(report.longrepr, "reprcrash", None) and report.longrepr.reprcrash.message or report.longrepr)
+        item.config.stash.setdefault(_RECORDS_KEY, []).append({
+            "nodeid": report.nodeid,
+            "check": getattr(item, "originalname", item.name),
+            "scene": marker.args[0] if marker is not None else None,
+            "when": report.when,
+            "outcome": "xfailed" if hasattr(report, "wasxfail") and report.skipped else report.outcome,
+            "worst": item.stash.get(WORST, None),
+            "message": message.strip().splitlines()[0][:500] if message.strip() else "",
+        })
     return report
+
+
+def pytest_sessionfinish(session: pytest.Session, exitstatus) -> None:
+    path = _option(session.config, "report")
+    if not path:
+        return
+    import json
+    import os
+
+    records = session.config.stash.get(_RECORDS_KEY, [])
+    payload = {"sync": _sync_spec(session.config), "exitstatus": int(exitstatus), "records": records}
+    tmp = f"{path}.tmp"
+    with open(tmp, "w", encoding="utf-8") as fh:
+        json.dump(payload, fh, indent=1, default=float)
+    os.replace(tmp, path)  # never a half-written report
 
 
 def pytest_terminal_summary(terminalreporter, exitstatus, config: pytest.Config) -> None:

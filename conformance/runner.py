@@ -1,17 +1,20 @@
 """Run a scene with a sync implementation: build, set up the sync, and advance frame by frame.
 
-The order of a frame is fixed: the scene's actions for that step, ``p.stepSimulation()``, then the
-sync under test. Frame 0 is the sync called once right after set-up, before any step.
+The order of a frame is fixed: the events of that frame (teleports, joint resets, kicks; see
+:mod:`conformance.events`), the scene's own actions, ``p.stepSimulation()``, then the sync under
+test. Frame 0 is the sync called once right after set-up (after frame-0 events), before any step.
 """
 
 from __future__ import annotations
 
 import contextlib
+from collections import defaultdict
 from dataclasses import dataclass, field
-from typing import Any, Iterator, Mapping
+from typing import Any, Iterator, Mapping, Sequence
 
 from conformance import backends
 from conformance.backends import Drawing
+from conformance.events import Event
 from conformance.scenes import Scene, build
 from conformance.sync import Syncer, SyncImplementation
 
@@ -25,13 +28,39 @@ class Run:
     syncer: Syncer
     frame: int = 0
     params: Mapping[str, Any] = field(default_factory=dict)
+    events: Sequence[Event] = ()
+
+    def __post_init__(self):
+        self._by_frame = defaultdict(list)
+        for event in self.events:
+            self._by_frame[event.frame].append(event)
+        #: Each actor's vertex count, topology and colours as built, before any sync.
+        self.built_mesh = {name: backends.mesh_signature(a) for name, a in self.drawing.actors.items()}
+        #: (frame, actor name) of every sync that changed an actor's data without telling VTK.
+        self.unannounced: list[tuple[int, str]] = []
+
+    def step(self) -> None:
+        """One frame of physics without syncing: events, actions, ``stepSimulation``."""
+        self.frame += 1
+        for event in self._by_frame.get(self.frame, ()):
+            event.apply(self.scene)
+        self.scene.advance(self.frame - 1)
+
+    def sync(self) -> None:
+        """Call the sync under test for the current frame, noting changes VTK was not told about: a
+        live renderer re-uploads geometry only when the data's modification time moves."""
+        before = {name: backends.content_state(a) for name, a in self.drawing.actors.items()}
+        self.syncer(self.frame)
+        for name, a in self.drawing.actors.items():
+            mtime, digest = backends.content_state(a)
+            if digest != before[name][1] and mtime <= before[name][0]:
+                self.unannounced.append((self.frame, name))
 
     def advance(self, frames: int = 1) -> None:
         """Step and sync ``frames`` times."""
         for _ in range(frames):
-            self.scene.advance(self.frame)
-            self.frame += 1
-            self.syncer(self.frame)
+            self.step()
+            self.sync()
 
     def frames(self, count: int) -> Iterator[int]:
         """Advance ``count`` frames, yielding the frame number after each (1-based)."""
@@ -41,10 +70,14 @@ class Run:
 
 
 @contextlib.contextmanager
-def running(scene: str, implementation: SyncImplementation, **params: Any) -> Iterator[Run]:
-    """Build ``scene`` with ``params``, draw it, start the sync and sync frame 0; always disconnect."""
+def running(scene: str, implementation: SyncImplementation, events: Sequence[Event] = (), **params: Any) -> Iterator[Run]:
+    """Build ``scene`` with ``params``, draw it, start the sync, apply frame-0 events and sync frame 0;
+    always disconnect."""
     with build(scene, **params) as built:
         drawing = backends.build(built)
         syncer = implementation.start(drawing.world)
-        syncer(0)
-        yield Run(scene=built, drawing=drawing, syncer=syncer, params=dict(built.params))
+        run = Run(scene=built, drawing=drawing, syncer=syncer, params=dict(built.params), events=tuple(events))
+        for event in run._by_frame.get(0, ()):
+            event.apply(built)
+        run.sync()
+        yield run

@@ -1,21 +1,166 @@
 """Vertex conformance: after every frame, what FURY draws is where pybullet says each body is.
 
 Ground truth is the kit's own (``conformance.truth``): each target's geometry captured in its link
-frame when the actor was built, moved by pybullet's link-frame pose; read-back is what VTK will draw
-(polydata points through the actor's full matrix). The sync's own bookkeeping is never read.
+frame when the actor was built, moved by pybullet's link-frame pose (base:
+``getBasePositionAndOrientation`` with the inertial offset undone; link: ``getLinkState(...)[4:6]``
+with forward kinematics); read-back is what VTK will draw (polydata points through the actor's full
+matrix). The sync's own bookkeeping is never read. Every check looks at every frame it runs.
 """
 
 from __future__ import annotations
 
-from conformance import compare, scenes
-from conformance.pytest_helpers import assert_vertices_match, each_scene, sync_run
+import numpy as np
+import pytest
+from hypothesis import given, strategies as st
+
+from conformance import backends, compare, scenes, strategies
+from conformance.events import JointReset, Teleport
+from conformance.profiles import check_settings
+from conformance.pytest_helpers import _context, each_scene, reproduce_command
+
+
+def _scene_runs(scene_name: str, longest: int):
+    """(parameters, frame count, events) for one scene, drawn together so events fit the run."""
+    return strategies.scene_parameters(scene_name).flatmap(
+        lambda params: strategies.frame_counts(longest).flatmap(
+            lambda frames: st.tuples(st.just(params), st.just(frames), strategies.events(frames))))
 
 
 @each_scene()
-def test_vertices_match_poses_every_frame(scene_name, sync_implementation):
-    """The guide's scenes with their own parameters: every target, every frame of the default run."""
+def test_vertices_match_poses_every_frame(scene_name, kit):
+    """The scene with its own parameters (the guide's, for the guide's scenes): every target, every
+    frame of the default run, from frame 0 (right after set-up) on."""
     spec = scenes.get(scene_name)
-    with sync_run(scene_name, sync_implementation) as run:
-        assert_vertices_match(compare.compare_vertices(run.drawing, 0), run=run, sync=sync_implementation.spec)
-        for frame in run.frames(spec.steps):
-            assert_vertices_match(compare.compare_vertices(run.drawing, frame), run=run, sync=sync_implementation.spec)
+    with kit.run(scene_name) as run:
+        kit.assert_frame(run)
+        for _ in run.frames(min(spec.steps, 400)):
+            kit.assert_frame(run)
+
+
+@each_scene()
+def test_vertices_match_through_teleports_and_kicks(scene_name, kit):
+    """Hypothesis varies the scene's parameters, the run's length (0 frames up) and what happens
+    between syncs: ``resetBasePositionAndOrientation`` to any orientation, ``resetJointState``,
+    and forces and torques that set bodies moving and spinning."""
+
+    @check_settings(examples=4)
+    @given(run_plan=_scene_runs(scene_name, longest=40))
+    def check(run_plan):
+        params, frames, events = run_plan
+        with kit.run(scene_name, events=events, **params) as run:
+            kit.assert_frame(run)
+            for _ in run.frames(frames):
+                kit.assert_frame(run)
+
+    check()
+
+
+@each_scene()
+def test_vertices_match_in_every_orientation(scene_name, kit):
+    """Every body teleported to an orientation drawn uniformly over rotations or from the cases that
+    break sloppy code (identity, half turns, pitch at and near ±90°, negative w), every spherical
+    joint turned likewise, before the first sync; then a few frames of the motion that follows."""
+
+    @check_settings(examples=5)
+    @given(params=strategies.scene_parameters(scene_name),
+           turns=st.lists(strategies.orientations(), min_size=1, max_size=6),
+           frames=st.integers(0, 3))
+    def check(params, turns, frames):
+        with scenes.build(scene_name, **params) as probe:
+            bodies = len({b.body for b in probe.bindings})
+        events = [Teleport(0, i, (0.0, 0.0, 0.0), turns[i % len(turns)]) for i in range(bodies)]
+        events += [JointReset(0, i, 1.0, turns[i % len(turns)]) for i in range(8)]
+        with kit.run(scene_name, events=events, **params) as run:
+            kit.assert_frame(run)
+            for _ in run.frames(frames):
+                kit.assert_frame(run)
+
+    check()
+
+
+@pytest.mark.scene("tumbling")
+def test_no_drift_over_ten_thousand_frames(kit):
+    """Bodies tumbling through every attitude for 10,000 frames (42 s of simulated time), checked
+    after every frame: an implementation that accumulates per-frame increments must keep its
+    rounding within the same tolerance as one that computes each frame from the pose."""
+    with kit.run("tumbling") as run:
+        kit.assert_frame(run)
+        for _ in run.frames(10_000):
+            kit.assert_frame(run)
+
+
+@each_scene()
+def test_sync_does_not_touch_physics(scene_name, kit):
+    """A sync only reads pybullet: every body's pose, velocity, joint states and dynamics and the
+    engine parameters are bit-identical before and after each sync call."""
+    spec = scenes.get(scene_name)
+    with kit.run(scene_name) as run:
+        for _ in range(min(spec.steps, 30)):
+            run.step()
+            before = run.scene.physics_state()
+            run.sync()
+            after = run.scene.physics_state()
+            if before != after:
+                changed = [a.decode() for a, b in zip(before.splitlines(), after.splitlines()) if a != b]
+                pytest.fail(
+                    f"the sync changed pybullet's state: {changed[0][:300]} … [{scene_name}, frame {run.frame}, "
+                    f"sync {kit.sync!r}] ({len(changed)} entries changed)", pytrace=False)
+
+
+@each_scene()
+def test_sync_keeps_the_mesh(scene_name, kit):
+    """A sync moves vertices and nothing else: every actor keeps its vertex count, its cells
+    (topology) and its vertex colours, and the scene keeps its actors."""
+    spec = scenes.get(scene_name)
+    with kit.run(scene_name) as run:
+        for frame in [0, *run.frames(min(spec.steps, 30))]:
+            for name, actor in run.drawing.actors.items():
+                now = backends.mesh_signature(actor)
+                if now != run.built_mesh[name]:
+                    what = [w for w, a, b in zip(("vertex count", "cells", "colours"), now, run.built_mesh[name]) if a != b]
+                    pytest.fail(f"actor {name!r}: {', '.join(what)} changed, but a sync should only move vertices "
+                                f"[{scene_name}, frame {frame}, sync {kit.sync!r}]", pytrace=False)
+
+
+@each_scene()
+def test_syncing_every_frame_equals_syncing_once(scene_name, kit):
+    """Syncing after every step and syncing once after N steps draw the same vertices: a sync depends
+    on the pose, not on having been called for each frame in between."""
+
+    @check_settings(examples=2)
+    @given(params=strategies.scene_parameters(scene_name), frames=st.integers(1, 30))
+    def check(params, frames):
+        drawn = []
+        for every_frame in (True, False):
+            with kit.run(scene_name, **params) as run:
+                for _ in range(frames):
+                    run.step()
+                    if every_frame:
+                        run.sync()
+                if not every_frame:
+                    run.sync()
+                drawn.append({name: backends.world_vertices(a) for name, a in run.drawing.actors.items()})
+                tolerance = max(r.tolerance for r in compare.compare_vertices(run.drawing, frames, kit.tolerance))
+                context = _context(run, kit.sync, frames)
+        for name in drawn[0]:
+            gap = float(np.nan_to_num(np.abs(drawn[0][name] - drawn[1][name]), nan=np.inf).max())
+            assert gap <= tolerance, (
+                f"actor {name!r} is drawn {gap:.3g} m apart when synced every frame and when synced once after "
+                f"{frames} frames, but should agree within {tolerance:.3g} m {context}")
+
+    check()
+
+
+@each_scene()
+def test_drawn_bounds_agree_with_get_aabb(scene_name, kit):
+    """Each drawn body's world bounding box lies inside pybullet's ``getAABB`` and reaches it on every
+    side within the stated margin (see ``conformance.tolerances``), at the first, middle and last frame."""
+    spec = scenes.get(scene_name)
+    steps = min(spec.steps, 400)
+    with kit.run(scene_name) as run:
+        for frame in (0, steps // 2, steps):
+            run.advance(frame - run.frame)
+            failures = [r for r in compare.compare_bounds(run.drawing, frame, kit.tolerance) if not r.ok]
+            if failures:
+                pytest.fail(f"{failures[0].target!r}: {'; '.join(failures[0].problems)} {_context(run, kit.sync, frame)}\n"
+                            f"reproduce: {reproduce_command(scene_name, kit.sync, frame, run.params)}", pytrace=False)

@@ -11,6 +11,16 @@ A correct sync makes two kinds of error, and the tolerance allows for both, no m
 
 So ``tolerance = SIZE_RTOL · extent + POSITION_RTOL · (|origin distance| + extent) + ATOL``.
 A sync that is one step late at 1 m/s is off by 4 mm: a thousand times more.
+
+Vertex normals (stored for spheres) must point within ``normal_angle`` radians of the body's
+rotated normals: float32 storage and pybullet's float32 helpers account for ~1e-6; we allow 1e-4.
+
+World bounds agree with ``getAABB`` when the drawn box lies inside pybullet's (within the vertex
+tolerance) and reaches it on every side within ``bounds_rtol`` (2.5 %) of the shape's size: FURY's
+spheres are tessellated with 16 segments, so in the worst direction their vertices reach
+cos(π/16) = 98.1 % of the radius. pybullet's box is exact for boxes and spheres; for cylinders, and
+for any shape it holds in a rotated local frame (a compound), it reports the box around the rotated
+bounding box, looser by up to (√3 − 1) of the size, so there ``loose_bounds_rtol`` (0.74) applies.
 """
 
 from __future__ import annotations
@@ -27,6 +37,9 @@ class Tolerance:
     size_rtol: float = 1e-5
     position_rtol: float = 2.4e-7
     atol: float = 1e-9
+    normal_angle: float = 1e-4
+    bounds_rtol: float = 0.025
+    loose_bounds_rtol: float = 0.74
 
     def for_geometry(self, local: np.ndarray, position) -> float:
         """Tolerance for a body whose link-frame geometry is ``local`` and whose frame is at ``position``."""

@@ -232,6 +232,22 @@ class Scene:
             rows.append((*lin, *ang))
         return np.asarray(rows, dtype=np.float64).reshape(-1, 6)
 
+    def physics_state(self) -> bytes:
+        """Every body's base pose and velocity, every joint's state, every link's dynamics, and the
+        engine parameters, as bytes: equal bytes mean pybullet holds exactly the same state."""
+        p = self.p
+        parts = [repr(sorted(p.getPhysicsEngineParameters().items()))]
+        for i in range(p.getNumBodies()):
+            body = p.getBodyUniqueId(i)
+            parts.append(repr((body, p.getBasePositionAndOrientation(body), p.getBaseVelocity(body),
+                               p.getDynamicsInfo(body, -1))))
+            joints = list(range(p.getNumJoints(body)))
+            if joints:
+                parts.append(repr(p.getJointStatesMultiDof(body, joints)))
+                parts.append(repr([p.getDynamicsInfo(body, j) for j in joints]))
+        # repr of a float is exact (shortest round-trip), so equal text is bit-identical state.
+        return "\n".join(parts).encode()
+
     def reproduce(self) -> str:
         """A Python expression that rebuilds this scene."""
         args = ", ".join(f"{k}={v!r}" for k, v in self.params.items())

@@ -26,6 +26,7 @@ _MODULES = (
     "bouncing_ball",
     "pendulum",
     "mixed_shapes",
+    "tumbling",
 )
 
 

@@ -12,7 +12,7 @@ import pytest
 from conformance import sync
 from conformance.errors import SyncLoadError, SyncProtocolError
 
-RUN = ["--pyargs", "conformance", "-k", "test_vertices and free_fall", "-p", "no:cacheprovider"]
+RUN = ["--pyargs", "conformance", "-k", "test_vertices_match_poses_every_frame and free_fall", "-p", "no:cacheprovider"]
 
 
 def _write(pytester, name: str, source: str) -> None:

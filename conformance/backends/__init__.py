@@ -4,7 +4,9 @@ The rest of the kit talks to a backend only through these functions:
 
 * ``build(scene) -> Drawing``: actors for every binding, with each target's reference geometry;
 * ``world_vertices(actor) -> (n, 3)``: what the renderer will draw, in world coordinates;
+* ``world_normals(actor)``: the stored vertex normals as they will be lit, or None;
 * ``mesh_signature(actor)``: vertex count, topology and colours, to check a sync keeps the mesh;
+* ``content_state(actor)``: modification time and data digest, to check changes are announced;
 * ``render(drawing, camera, size) -> (h, w, 3) uint8``: an off-screen picture.
 
 FURY 0.12 (VTK) is the only backend today; FURY 2.x (pygfx) would be a sibling module.
@@ -12,6 +14,6 @@ FURY 0.12 (VTK) is the only backend today; FURY 2.x (pygfx) would be a sibling m
 
 from __future__ import annotations
 
-from .vtk import Drawing, build, mesh_signature, render, world_vertices
+from .vtk import Drawing, build, content_state, mesh_signature, render, world_normals, world_vertices
 
-__all__ = ["Drawing", "build", "mesh_signature", "render", "world_vertices"]
+__all__ = ["Drawing", "build", "content_state", "mesh_signature", "render", "world_normals", "world_vertices"]

@@ -13,13 +13,14 @@ from typing import Any, Sequence
 
 import numpy as np
 from vtkmodules.util import numpy_support
+from vtkmodules.vtkCommonMath import vtkMatrix4x4
 
 from conformance import poses, truth
 from conformance.display import ensure_display
 from conformance.errors import SceneError
 from conformance.world import Target, World
 
-__all__ = ["Drawing", "build", "mesh_signature", "render", "world_vertices"]
+__all__ = ["Drawing", "build", "content_state", "mesh_signature", "render", "world_normals", "world_vertices"]
 
 IDENTITY_POSITION = np.zeros(3)
 IDENTITY_ORIENTATION = np.array([0.0, 0.0, 0.0, 1.0])
@@ -142,10 +143,40 @@ def world_vertices(actor) -> np.ndarray:
     """The actor's vertices as VTK will draw them: polydata points through ``actor.GetMatrix()``,
     which composes position, orientation, origin, scale, user matrix and user transform."""
     points = np.asarray(_points(actor), dtype=np.float64)
-    matrix = np.array([[actor.GetMatrix().GetElement(r, c) for c in range(4)] for r in range(4)])
+    matrix = _matrix(actor)
     homogeneous = points @ matrix[:3, :3].T + matrix[:3, 3]
     w = points @ matrix[3, :3] + matrix[3, 3]
     return homogeneous / w[:, None]
+
+
+def _matrix(actor) -> np.ndarray:
+    """The actor's full 4x4 matrix (position, orientation, origin, scale, user matrix and transform)."""
+    elements = [0.0] * 16
+    matrix = actor.GetMatrix()
+    matrix.DeepCopy(elements, matrix)  # the static overload: fill `elements` from `matrix`
+    return np.array(elements).reshape(4, 4)
+
+
+def world_normals(actor) -> np.ndarray | None:
+    """The actor's stored vertex normals as VTK will light them (through the inverse transpose of
+    the actor's matrix), unit length; None when the actor stores none."""
+    normals = _normals(actor)
+    if normals is None:
+        return None
+    linear = _matrix(actor)[:3, :3]
+    turned = np.asarray(normals, dtype=np.float64) @ np.linalg.inv(linear)
+    return turned / np.linalg.norm(turned, axis=1, keepdims=True)
+
+
+def content_state(actor) -> tuple[int, str]:
+    """The modification time VTK's mapper compares to decide whether to re-upload the geometry, and
+    a digest of the point and normal data, to tell a change VTK was told about from one it was not."""
+    data = actor.GetMapper().GetInput()
+    digest = hashlib.sha1(np.ascontiguousarray(_points(actor)).tobytes())
+    normals = _normals(actor)
+    if normals is not None:
+        digest.update(np.ascontiguousarray(normals).tobytes())
+    return data.GetMTime(), digest.hexdigest()
 
 
 def mesh_signature(actor) -> tuple[int, str, str]:

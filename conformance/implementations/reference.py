@@ -43,10 +43,17 @@ class ReferenceSync:
                 inverse = Rotation.from_quat(orn).inv()
                 self._base_offsets[t.body] = (-inverse.apply(pos), inverse)
         links = defaultdict(list)
-        for t in self.targets:
+        self._link_rows = defaultdict(list)
+        for i, t in enumerate(self.targets):
             if t.link >= 0:
                 links[t.body].append(t.link)
+                self._link_rows[t.body].append(i)
         self._links = {body: sorted(set(ids)) for body, ids in links.items()}
+        self._base_rows = [i for i, t in enumerate(self.targets) if t.link == -1]
+        if self._base_rows:
+            self._base_offset_pos = np.array([self._base_offsets[self.targets[i].body][0] for i in self._base_rows])
+            self._base_offset_rot = Rotation.concatenate([self._base_offsets[self.targets[i].body][1]
+                                                          for i in self._base_rows])
         # Geometry in the link frame, recovered once from the vertices as drawn at set-up.
         self._shared: dict[int, tuple[object, list[int], np.ndarray, np.ndarray | None]] = {}
         self._whole: list[tuple[int, object]] = []
@@ -73,24 +80,18 @@ class ReferenceSync:
             self._shared[id(actor)] = (actor, members, local, local_normals)
 
     def _poses(self) -> tuple[np.ndarray, np.ndarray]:
-        link_poses = {}
-        for body, ids in self._links.items():
-            for link, state in zip(ids, self.p.getLinkStates(body, ids, computeForwardKinematics=1)):
-                link_poses[body, link] = state[4], state[5]
         positions = np.empty((len(self.targets), 3))
-        rotations = []
-        for i, t in enumerate(self.targets):
-            if t.link == -1:
-                com_pos, com_orn = self.p.getBasePositionAndOrientation(t.body)
-                offset_pos, offset_rot = self._base_offsets[t.body]
-                com = Rotation.from_quat(com_orn)
-                positions[i] = com.apply(offset_pos) + com_pos
-                rotations.append((com * offset_rot).as_quat())
-            else:
-                pos, orn = link_poses[t.body, t.link]
-                positions[i] = pos
-                rotations.append(orn)
-        return positions, Rotation.from_quat(np.asarray(rotations)).as_matrix()
+        orientations = np.empty((len(self.targets), 4))
+        for body, ids in self._links.items():
+            states = dict(zip(ids, self.p.getLinkStates(body, ids, computeForwardKinematics=1)))
+            for i in self._link_rows[body]:
+                positions[i], orientations[i] = states[self.targets[i].link][4:6]
+        if self._base_rows:
+            com = [self.p.getBasePositionAndOrientation(self.targets[i].body) for i in self._base_rows]
+            com_rot = Rotation.from_quat([c[1] for c in com])
+            positions[self._base_rows] = np.array([c[0] for c in com]) + com_rot.apply(self._base_offset_pos)
+            orientations[self._base_rows] = (com_rot * self._base_offset_rot).as_quat()
+        return positions, Rotation.from_quat(orientations).as_matrix()
 
     def __call__(self) -> None:
         positions, matrices = self._poses()

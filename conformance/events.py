@@ -1,0 +1,132 @@
+"""Things that happen to a scene between syncs: teleports, joint resets and kicks.
+
+Each event is applied before the step of its frame (so frame ``n``'s sync sees its effect); a
+teleport at frame 0 moves a body after the actors were built and before the first sync. Events
+name their body by position in the scene's list of bodies (``which``, taken modulo that list's
+length), so a Hypothesis-drawn event fits any scene. Events round-trip through JSON so that a
+failure's "reproduce:" line can replay them.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import asdict, dataclass
+from typing import Sequence
+
+import pybullet
+
+__all__ = ["Event", "JointReset", "Kick", "Teleport", "dumps", "loads"]
+
+
+def _bodies(scene) -> list[int]:
+    return sorted({b.body for b in scene.bindings})
+
+
+def _joints(scene) -> list[tuple[int, int]]:
+    """(body, joint) pairs of revolute, prismatic and spherical joints: those ``resetJoint*`` moves."""
+    found = []
+    for body in _bodies(scene):
+        for joint in range(scene.p.getNumJoints(body)):
+            kind = scene.p.getJointInfo(body, joint)[2]
+            if kind in (pybullet.JOINT_REVOLUTE, pybullet.JOINT_PRISMATIC, pybullet.JOINT_SPHERICAL):
+                found.append((body, joint))
+    return found
+
+
+@dataclass(frozen=True)
+class Teleport:
+    """``resetBasePositionAndOrientation`` of a body to ``position``/``orientation`` (relative to where
+    it is, for ``position``, so that a teleported body stays in view)."""
+
+    frame: int
+    which: int
+    offset: tuple[float, float, float]
+    orientation: tuple[float, float, float, float]
+
+    def apply(self, scene) -> None:
+        bodies = _bodies(scene)
+        body = bodies[self.which % len(bodies)]
+        pos, _ = scene.p.getBasePositionAndOrientation(body)
+        scene.p.resetBasePositionAndOrientation(body, [a + b for a, b in zip(pos, self.offset)], list(self.orientation))
+
+
+@dataclass(frozen=True)
+class JointReset:
+    """``resetJointState`` (or ``resetJointStateMultiDof`` for a spherical joint) to ``value``: an angle
+    or distance, or the quaternion ``orientation`` for spherical joints. No-op in a scene without joints."""
+
+    frame: int
+    which: int
+    value: float
+    orientation: tuple[float, float, float, float]
+
+    def apply(self, scene) -> None:
+        joints = _joints(scene)
+        if not joints:
+            return
+        body, joint = joints[self.which % len(joints)]
+        if scene.p.getJointInfo(body, joint)[2] == pybullet.JOINT_SPHERICAL:
+            scene.p.resetJointStateMultiDof(body, joint, targetValue=list(self.orientation), targetVelocity=[0, 0, 0])
+        else:
+            scene.p.resetJointState(body, joint, self.value)
+
+
+@dataclass(frozen=True)
+class Kick:
+    """One step of ``applyExternalForce`` (at ``offset`` from the centre of mass) and
+    ``applyExternalTorque``, both WORLD_FRAME, sized to change the base's velocity by about
+    ``velocity`` (m/s) and its angular velocity by about ``spin`` (rad/s): sets a body moving and
+    spinning whatever its mass and inertia."""
+
+    frame: int
+    which: int
+    velocity: tuple[float, float, float]
+    offset: tuple[float, float, float]
+    spin: tuple[float, float, float]
+
+    def apply(self, scene) -> None:
+        from conformance import poses
+
+        bodies = _bodies(scene)
+        body = bodies[self.which % len(bodies)]
+        info = scene.p.getDynamicsInfo(body, -1)
+        mass, inertia = info[0], info[2]
+        if mass == 0:
+            return  # a static body ignores forces
+        dt = scene.dt
+        pos, orn = scene.p.getBasePositionAndOrientation(body)
+        # The COM frame is the principal-axes frame, so I_world = R diag(I) Rᵀ.
+        rotation = poses.matrices(orn)
+        torque = rotation @ (list(inertia) * (rotation.T @ self.spin)) / dt
+        scene.p.applyExternalForce(body, -1, [mass * v / dt for v in self.velocity],
+                                   [a + b for a, b in zip(pos, self.offset)], pybullet.WORLD_FRAME)
+        scene.p.applyExternalTorque(body, -1, [float(t) for t in torque], pybullet.WORLD_FRAME)
+
+
+Event = Teleport | JointReset | Kick
+_KINDS = {"teleport": Teleport, "joint_reset": JointReset, "kick": Kick}
+
+
+def dumps(events: Sequence[Event]) -> str:
+    names = {cls: name for name, cls in _KINDS.items()}
+    return json.dumps([{"kind": names[type(e)], **asdict(e)} for e in events], separators=(",", ":"))
+
+
+def loads(text: str) -> list[Event]:
+    from conformance.errors import InvalidArgument
+
+    try:
+        items = json.loads(text)
+        events = []
+        for item in items:
+            item = dict(item)
+            cls = _KINDS[item.pop("kind")]
+            events.append(cls(**{k: tuple(v) if isinstance(v, list) else v for k, v in item.items()}))
+    except (ValueError, KeyError, TypeError) as exc:
+        raise InvalidArgument(f"events={text[:200]!r} is not a list of events as the kit writes them ({exc})") from None
+    for e in events:
+        values = [v for v in asdict(e).values() for v in (v if isinstance(v, tuple) else (v,))]
+        if not all(math.isfinite(v) for v in values):
+            raise InvalidArgument(f"event {e!r} has a non-finite value")
+    return events
