@@ -3,8 +3,11 @@
 * ``run [--sync SPEC] [pytest args]``: the conformance checks, with a verdict per scene;
 * ``scenes``: the reference scenes and their parameters;
 * ``render SCENE [--step N] [--out PNG]``: a picture of a scene at a step, synced by a sync;
-* ``check SCENE [--sync SPEC] [--frames N] [--params JSON]``: replay one run frame by frame and
-  print each frame's worst error (what a failing check's "reproduce:" line runs).
+* ``check SCENE [--sync SPEC] [--frames N] [--params JSON] [--events JSON]``: replay one run frame
+  by frame and print each frame's worst error (what a failing check's "reproduce:" line runs);
+* ``verdicts SPEC…``: the checks against several syncs, as markdown verdict tables;
+* ``kill-rate --wrong MODULE --right MODULE``: how many deliberately wrong syncs the checks reject;
+* ``documented``: pybullet's behaviour measured against its documentation, as a markdown table.
 """
 
 from __future__ import annotations
@@ -113,6 +116,47 @@ def _cmd_check(args, extra) -> int:
     return 1
 
 
+def _cmd_verdicts(args, extra) -> int:
+    from conformance import verdicts
+
+    outcomes = verdicts.check_all(args.specs, pytest_args=extra, jobs=args.jobs)
+    text = verdicts.verdict_tables(outcomes)
+    _emit(text, args.out)
+    return 0
+
+
+def _cmd_kill_rate(args, extra) -> int:
+    import importlib
+    import inspect
+
+    from conformance import verdicts
+
+    def specs(module_name: str) -> list[str]:
+        module = importlib.import_module(module_name)
+        return [f"{module_name}:{name}" for name, obj in vars(module).items()
+                if inspect.isclass(obj) and obj.__module__ == module_name and not name.startswith("_")]
+
+    wrong, right = specs(args.wrong), specs(args.right)
+    # A wrong implementation needs only its first failure; a right one must pass everything.
+    outcomes = verdicts.check_all(wrong, stop_at_first=True, pytest_args=extra, jobs=args.jobs)
+    accepted = verdicts.check_all(right, pytest_args=extra, jobs=args.jobs)
+    _emit(verdicts.kill_rate_table(outcomes, accepted), args.out)
+    return 0 if all(o.failed for o in outcomes) and all(o.passed for o in accepted) else 1
+
+
+def _cmd_documented(args, extra) -> int:
+    from conformance import documented
+
+    _emit(documented.table(), args.out)
+    return 0
+
+
+def _emit(text: str, out: str | None) -> None:
+    print(text)
+    if out:
+        Path(out).write_text(text + "\n", encoding="utf-8")
+
+
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="python -m conformance", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
@@ -139,6 +183,20 @@ def _parser() -> argparse.ArgumentParser:
     check.add_argument("--params", default=None, help="scene parameters as a JSON object")
     check.add_argument("--events", default=None, help="teleports, joint resets and kicks as JSON (from a failure)")
     check.add_argument("-v", "--verbose", action="store_true", help="print every frame, not only failing ones")
+    verdict = sub.add_parser("verdicts", help="check several syncs and print markdown verdict tables "
+                                                "(extra arguments go to pytest, e.g. --hypothesis-profile ci)")
+    verdict.add_argument("specs", nargs="+", help="sync implementations (short names or module:attribute)")
+    verdict.add_argument("--out", default=None, help="also write the markdown here")
+    verdict.add_argument("--jobs", type=int, default=None, help="pytest processes at a time (default 1)")
+
+    kill = sub.add_parser("kill-rate", help="check every class of a module of wrong syncs and one of right syncs")
+    kill.add_argument("--wrong", required=True, help="module whose classes are wrong sync implementations")
+    kill.add_argument("--right", required=True, help="module whose classes are right sync implementations")
+    kill.add_argument("--out", default=None, help="also write the markdown here")
+    kill.add_argument("--jobs", type=int, default=None)
+
+    doc = sub.add_parser("documented", help="measure pybullet against its documentation and print the table")
+    doc.add_argument("--out", default=None, help="also write the markdown here")
     return parser
 
 
@@ -146,11 +204,12 @@ def main(argv: list[str] | None = None) -> int:
     from conformance.sync import resolve_spec
 
     args, extra = _parser().parse_known_args(argv)
-    if extra and args.command != "run":
+    if extra and args.command not in ("run", "verdicts", "kill-rate"):
         _parser().error(f"unrecognized arguments: {' '.join(extra)}")
     if hasattr(args, "sync"):
         args.sync = resolve_spec(args.sync)
-    handler = {"run": _cmd_run, "scenes": _cmd_scenes, "render": _cmd_render, "check": _cmd_check}[args.command]
+    handler = {"run": _cmd_run, "scenes": _cmd_scenes, "render": _cmd_render, "check": _cmd_check,
+               "verdicts": _cmd_verdicts, "kill-rate": _cmd_kill_rate, "documented": _cmd_documented}[args.command]
     try:
         return handler(args, extra)
     except ConformanceError as err:

@@ -13,9 +13,10 @@ import shutil
 
 from conformance.errors import DisplayUnavailable
 
-__all__ = ["ensure_display", "stop_display", "virtual_display"]
+__all__ = ["ensure_display", "on_stop", "stop_display", "virtual_display"]
 
 _started = None  # the pyvirtualdisplay.Display this process started, if any
+_on_stop = []  # callbacks that let go of X resources before the display goes away
 
 INSTALL_HINT = (
     "install it with `sudo apt-get install xvfb` (Debian/Ubuntu; `dnf install xorg-x11-server-Xvfb` on Fedora), "
@@ -45,9 +46,17 @@ def ensure_display() -> str:
     return os.environ["DISPLAY"]
 
 
+def on_stop(callback) -> None:
+    """Call ``callback()`` before the display this process started is stopped (once)."""
+    _on_stop.append(callback)
+
+
 def stop_display() -> None:
-    """Stop the Xvfb this process started (restores the previous DISPLAY); no-op otherwise."""
+    """Stop the Xvfb this process started (restores the previous DISPLAY); no-op otherwise.
+    Whatever holds a connection to it is released first, or Xlib kills the process at exit."""
     global _started
+    while _on_stop:
+        _on_stop.pop()()
     if _started is not None:
         display, _started = _started, None
         display.stop()

@@ -166,14 +166,14 @@ def lever_arms(scale: float = 0.2) -> st.SearchStrategy[tuple[float, float, floa
     return st.one_of(st.just((0.0, 0.0, 0.0)), _vectors(scale))
 
 
-def spins(scale: float = 5.0) -> st.SearchStrategy[tuple[float, float, float]]:
-    """Angular velocities in rad/s."""
-    return _vectors(scale)
+def spins(scale: float = 5.0, least: float = 0.0) -> st.SearchStrategy[tuple[float, float, float]]:
+    """Angular velocities in rad/s, each component in [-scale, scale], of norm at least ``least``."""
+    return _vectors(scale).filter(lambda v: math.hypot(*v) >= least)
 
 
-def velocities(scale: float = 5.0) -> st.SearchStrategy[tuple[float, float, float]]:
-    """Linear velocities in m/s."""
-    return _vectors(scale)
+def velocities(scale: float = 5.0, least: float = 0.0) -> st.SearchStrategy[tuple[float, float, float]]:
+    """Linear velocities in m/s, each component in [-scale, scale], of norm at least ``least``."""
+    return _vectors(scale).filter(lambda v: math.hypot(*v) >= least)
 
 
 def force_frames() -> st.SearchStrategy[str]:
@@ -249,14 +249,35 @@ def toggle_schedules(last_step: int, most: int = 4) -> st.SearchStrategy[list[tu
     return st.lists(call, min_size=1, max_size=most).map(lambda calls: sorted(calls, key=lambda c: c[0]))
 
 
+def free_bodies(kinds=("box", "sphere", "cylinder")) -> st.SearchStrategy[dict]:
+    """Parameters of the ``free_fall`` scene: any shape kind, size, mass, orientation and spin.
+    Sizes from 0.1 m and masses from 0.5 kg keep the pushes drawn here under ~30 rad/s and ~1 m/s,
+    far from pybullet's ±100 clamp on every velocity coordinate."""
+    return st.fixed_dictionaries({
+        "kind": shape_kinds(kinds),
+        "size": sizes(0.1, 0.5),
+        "mass": masses(0.5, 10.0),
+        "orientation": orientations(),
+        "spin": spins(5.0),
+    })
+
+
+def speed_gains(low: float = 105.0, high: float = 400.0) -> st.SearchStrategy[tuple[float, float, float]]:
+    """Velocity changes in m/s with at least one component beyond ±``low`` (past the 100 m/s clamp)."""
+    big = st.floats(low, high, allow_nan=False).flatmap(lambda s: st.sampled_from([s, -s]))
+    small = st.floats(-low / 2, low / 2, allow_nan=False, allow_subnormal=False)
+    return st.tuples(big, small, small, st.integers(0, 2)).map(
+        lambda t: tuple(t[(i - t[3]) % 3] for i in range(3)))
+
+
 def crossing_parameters(**fixed) -> st.SearchStrategy[dict]:
     """Parameters of the ``crossing`` scene with ``fixed`` ones (e.g. ``collide=True``) overriding."""
     return scene_parameters("crossing").map(lambda d: {**d, **fixed})
 
 
 __all__ += [
-    "FORCE_FRAMES", "bitmasks", "crossing_parameters", "damping_factors", "filter_modes", "force_frames",
+    "FORCE_FRAMES", "bitmasks", "crossing_parameters", "damping_factors", "filter_modes", "force_frames", "free_bodies",
     "forces", "frictions", "group_masks", "landing_steps", "lever_arms", "masses", "one_way_group_masks",
-    "restitutions", "shape_kinds", "sizes", "spins", "substeps", "timesteps", "toggle_schedules", "torques",
+    "restitutions", "shape_kinds", "sizes", "speed_gains", "spins", "substeps", "timesteps", "toggle_schedules", "torques",
     "velocities",
 ]

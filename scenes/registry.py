@@ -27,6 +27,7 @@ _MODULES = (
     "pendulum",
     "mixed_shapes",
     "tumbling",
+    "crossing",
 )
 
 

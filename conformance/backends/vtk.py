@@ -16,7 +16,7 @@ from vtkmodules.util import numpy_support
 from vtkmodules.vtkCommonMath import vtkMatrix4x4
 
 from conformance import poses, truth
-from conformance.display import ensure_display
+from conformance.display import ensure_display, on_stop
 from conformance.errors import SceneError
 from conformance.world import Target, World
 
@@ -192,6 +192,31 @@ def mesh_signature(actor) -> tuple[int, str, str]:
     return data.GetNumberOfPoints(), cells.hexdigest(), color_digest
 
 
+_window = None  # one off-screen render window per process, created on first use
+
+
+def _render_window():
+    """The process's off-screen render window. VTK 9.3 aborts the whole process when it cannot
+    create a GLX context (seen on Mesa llvmpipe when several processes start rendering on a loaded
+    machine), so the kit creates one context per process and reuses it, instead of one per picture."""
+    global _window
+    if _window is None:
+        from fury import window
+
+        _window = window.RenderWindow()
+        _window.SetOffScreenRendering(1)
+        _window.SetMultiSamples(8)
+        on_stop(_release_window)
+    return _window
+
+
+def _release_window() -> None:
+    global _window
+    if _window is not None:
+        _window.Finalize()
+        _window = None
+
+
 def render(drawing: Drawing, camera, size: tuple[int, int], background=(1.0, 1.0, 1.0)) -> np.ndarray:
     """An off-screen picture of the drawing, ``(height, width, 3)`` uint8, top row first."""
     ensure_display()
@@ -202,7 +227,12 @@ def render(drawing: Drawing, camera, size: tuple[int, int], background=(1.0, 1.0
     for actor in drawing.actors.values():
         stage.add(actor)
     stage.set_camera(position=camera.position, focal_point=camera.focal_point, view_up=camera.view_up)
+    render_window = _render_window()
+    render_window.AddRenderer(stage)
+    render_window.SetSize(*size)
     try:
-        return window.snapshot(stage, size=tuple(size), offscreen=True)
+        render_window.Render()
+        return window.snapshot(stage, size=tuple(size), render_window=render_window)
     finally:
+        render_window.RemoveRenderer(stage)
         stage.clear()
