@@ -133,8 +133,10 @@ def _cmd_kill_rate(args, extra) -> int:
 
     def specs(module_name: str) -> list[str]:
         module = importlib.import_module(module_name)
-        return [f"{module_name}:{name}" for name, obj in vars(module).items()
-                if inspect.isclass(obj) and obj.__module__ == module_name and not name.startswith("_")]
+        names = getattr(module, "__all__", None) or [
+            name for name, obj in vars(module).items()
+            if inspect.isclass(obj) and obj.__module__ == module_name and not name.startswith("_")]
+        return [f"{module_name}:{name}" for name in names]
 
     wrong, right = specs(args.wrong), specs(args.right)
     # A wrong implementation needs only its first failure; a right one must pass everything.

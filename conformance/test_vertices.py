@@ -26,15 +26,48 @@ def _scene_runs(scene_name: str, longest: int):
             lambda frames: st.tuples(st.just(params), st.just(frames), strategies.events(frames))))
 
 
+def check_run(kit, scene_name: str, params: dict, frames: int, events=()) -> None:
+    """The core of the frame checks: run ``frames`` frames with ``events``; check frame 0 and every frame after."""
+    with kit.run(scene_name, events=events, **params) as run:
+        kit.assert_frame(run)
+        for _ in run.frames(frames):
+            kit.assert_frame(run)
+
+
+def turned_everything(scene_name: str, params: dict, turns) -> list:
+    """Frame-0 events turning every body, and every joint, to the orientations ``turns`` (cycled)."""
+    with scenes.build(scene_name, **params) as probe:
+        bodies = len({b.body for b in probe.bindings})
+    events = [Teleport(0, i, (0.0, 0.0, 0.0), turns[i % len(turns)]) for i in range(bodies)]
+    return events + [JointReset(0, i, 1.0, turns[i % len(turns)]) for i in range(8)]
+
+
+def check_every_frame_equals_once(kit, scene_name: str, params: dict, frames: int) -> None:
+    """The core of the every-frame-vs-once check."""
+    drawn = []
+    for every_frame in (True, False):
+        with kit.run(scene_name, **params) as run:
+            for _ in range(frames):
+                run.step()
+                if every_frame:
+                    run.sync()
+            if not every_frame:
+                run.sync()
+            drawn.append({name: backends.world_vertices(a) for name, a in run.drawing.actors.items()})
+            tolerance = max(r.tolerance for r in compare.compare_vertices(run.drawing, frames, kit.tolerance))
+            context = _context(run, kit.sync, frames)
+    for name in drawn[0]:
+        gap = float(np.nan_to_num(np.abs(drawn[0][name] - drawn[1][name]), nan=np.inf).max())
+        assert gap <= tolerance, (
+            f"actor {name!r} is drawn {gap:.3g} m apart when synced every frame and when synced once after "
+            f"{frames} frames, but should agree within {tolerance:.3g} m {context}")
+
+
 @each_scene()
 def test_vertices_match_poses_every_frame(scene_name, kit):
     """The scene with its own parameters (the guide's, for the guide's scenes): every target, every
     frame of the default run, from frame 0 (right after set-up) on."""
-    spec = scenes.get(scene_name)
-    with kit.run(scene_name) as run:
-        kit.assert_frame(run)
-        for _ in run.frames(min(spec.steps, 400)):
-            kit.assert_frame(run)
+    check_run(kit, scene_name, {}, min(scenes.get(scene_name).steps, 400))
 
 
 @each_scene()
@@ -47,10 +80,7 @@ def test_vertices_match_through_teleports_and_kicks(scene_name, kit):
     @given(run_plan=_scene_runs(scene_name, longest=40))
     def check(run_plan):
         params, frames, events = run_plan
-        with kit.run(scene_name, events=events, **params) as run:
-            kit.assert_frame(run)
-            for _ in run.frames(frames):
-                kit.assert_frame(run)
+        check_run(kit, scene_name, params, frames, events)
 
     check()
 
@@ -66,14 +96,7 @@ def test_vertices_match_in_every_orientation(scene_name, kit):
            turns=st.lists(strategies.orientations(), min_size=1, max_size=6),
            frames=st.integers(0, 3))
     def check(params, turns, frames):
-        with scenes.build(scene_name, **params) as probe:
-            bodies = len({b.body for b in probe.bindings})
-        events = [Teleport(0, i, (0.0, 0.0, 0.0), turns[i % len(turns)]) for i in range(bodies)]
-        events += [JointReset(0, i, 1.0, turns[i % len(turns)]) for i in range(8)]
-        with kit.run(scene_name, events=events, **params) as run:
-            kit.assert_frame(run)
-            for _ in run.frames(frames):
-                kit.assert_frame(run)
+        check_run(kit, scene_name, params, frames, turned_everything(scene_name, params, turns))
 
     check()
 
@@ -83,10 +106,7 @@ def test_no_drift_over_ten_thousand_frames(kit):
     """Bodies tumbling through every attitude for 10,000 frames (42 s of simulated time), checked
     after every frame: an implementation that accumulates per-frame increments must keep its
     rounding within the same tolerance as one that computes each frame from the pose."""
-    with kit.run("tumbling") as run:
-        kit.assert_frame(run)
-        for _ in run.frames(10_000):
-            kit.assert_frame(run)
+    check_run(kit, "tumbling", {}, 10_000)
 
 
 @each_scene()
@@ -130,23 +150,7 @@ def test_syncing_every_frame_equals_syncing_once(scene_name, kit):
     @check_settings(examples=2)
     @given(params=strategies.scene_parameters(scene_name), frames=st.integers(1, 30))
     def check(params, frames):
-        drawn = []
-        for every_frame in (True, False):
-            with kit.run(scene_name, **params) as run:
-                for _ in range(frames):
-                    run.step()
-                    if every_frame:
-                        run.sync()
-                if not every_frame:
-                    run.sync()
-                drawn.append({name: backends.world_vertices(a) for name, a in run.drawing.actors.items()})
-                tolerance = max(r.tolerance for r in compare.compare_vertices(run.drawing, frames, kit.tolerance))
-                context = _context(run, kit.sync, frames)
-        for name in drawn[0]:
-            gap = float(np.nan_to_num(np.abs(drawn[0][name] - drawn[1][name]), nan=np.inf).max())
-            assert gap <= tolerance, (
-                f"actor {name!r} is drawn {gap:.3g} m apart when synced every frame and when synced once after "
-                f"{frames} frames, but should agree within {tolerance:.3g} m {context}")
+        check_every_frame_equals_once(kit, scene_name, params, frames)
 
     check()
 
