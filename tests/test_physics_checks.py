@@ -97,7 +97,7 @@ def test_render_check_fails_when_physics_does_not_pass_through():
 
 def test_render_check_fails_when_the_sync_does_not_move_the_bodies():
     with pytest.raises(Failed, match=r"drawn centre of|is drawn at .* but should be at"):
-        filters.verify_drawn_overlap({**CROSSING, "collide": False}, sync.load("syncs:DoesNothing"))
+        filters.verify_drawn_overlap({**CROSSING, "collide": False}, sync.load("wrong_syncs:DoesNothing"))
 
 
 # -- forces and torques ------------------------------------------------------------------------

@@ -1,23 +1,93 @@
-"""The vertex check rejects wrong syncs and accepts right ones written in other styles."""
+"""Each vertex check fails on a sync that breaks the property it guards, with a readable message.
+
+The checks' cores are called with a chosen counter-example, so each test fails the check the same
+way every time; ``test_discrimination.py`` shows the Hypothesis-driven checks finding these
+mistakes on their own, end to end.
+"""
 
 from __future__ import annotations
 
+import math
+
+import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
 from conformance import sync
 from conformance import test_vertices as checks
+from conformance.events import Teleport
 from conformance.pytest_helpers import Kit
+from conformance.strategies import HARD_ORIENTATIONS
 from conformance.tolerances import DEFAULT
 
 Failed = pytest.fail.Exception
 
 
-@pytest.mark.parametrize("spec", ["syncs:DoesNothing", "syncs:OneStepLate", "syncs:TransposedRotation", "guide-actor"])
-def test_vertex_check_rejects_a_wrong_sync(spec):
+def kit(spec: str) -> Kit:
+    return Kit(sync.load(spec), DEFAULT)
+
+
+@pytest.mark.parametrize("spec", ["wrong_syncs:DoesNothing", "wrong_syncs:TransposedRotation", "guide-actor"])
+def test_every_frame_check_fails_on_a_wrong_pose(spec):
     with pytest.raises(Failed, match=r"is drawn at .* but should be at .*\[free_fall\(.*frame \d+.*\nreproduce: "):
-        checks.test_vertices_match_poses_every_frame("free_fall", Kit(sync.load(spec), DEFAULT))
+        checks.test_vertices_match_poses_every_frame("free_fall", kit(spec))
 
 
-@pytest.mark.parametrize("spec", ["reference", "syncs:UserMatrixSync"])
-def test_vertex_check_accepts_a_right_sync(spec):
-    checks.test_vertices_match_poses_every_frame("free_fall", Kit(sync.load(spec), DEFAULT))
+@pytest.mark.parametrize("spec", ["reference", "right_syncs:UserMatrixSync"])
+def test_every_frame_check_passes_a_right_sync(spec):
+    checks.test_vertices_match_poses_every_frame("free_fall", kit(spec))
+
+
+def test_teleport_check_fails_when_a_resting_body_is_teleported():
+    # The pendulum's mount is static: a sync that skips bodies at rest never redraws it.
+    teleport = Teleport(frame=3, which=0, offset=(0.3, 0.0, 0.2), orientation=(0.0, 0.0, 0.0, 1.0))
+    with pytest.raises(Failed, match=r"'mount' .* should be at .*frame 3.*events .*teleport.*\nreproduce: .*--events"):
+        checks.check_run(kit("wrong_syncs:VelocityGated"), "pendulum", {}, 5, [teleport])
+    checks.check_run(kit("reference"), "pendulum", {}, 5, [teleport])
+
+
+def test_orientation_check_fails_at_gimbal_lock():
+    gimbal = tuple(Rotation.from_euler("xyz", [0.7, math.pi / 2, -0.4]).as_quat())  # pitch exactly 90°
+    assert any(np.allclose(gimbal, q) for q in HARD_ORIENTATIONS), "the strategy must draw this case"
+    events = checks.turned_everything("free_fall", {}, [gimbal])
+    with pytest.raises(Failed, match=r"'body' .* should be at .*frame 0"):
+        checks.check_run(kit("wrong_syncs:EulerRotateXYZ"), "free_fall", {}, 0, events)
+    checks.check_run(kit("right_syncs:PositionOrientationSync"), "free_fall", {}, 0, events)
+
+
+def test_drift_check_fails_on_float32_increments():
+    with pytest.raises(Failed, match=r"tumbling\(.*frame \d+"):
+        checks.test_no_drift_over_ten_thousand_frames(kit("wrong_syncs:Float32Incremental"))
+
+
+def test_physics_check_fails_when_the_sync_writes_poses_back():
+    with pytest.raises(Failed, match=r"the sync changed pybullet's state: .*\[free_fall, frame 1"):
+        checks.test_sync_does_not_touch_physics("free_fall", kit("wrong_syncs:WritesPoseBack"))
+
+
+def test_mesh_check_fails_when_the_sync_recolours():
+    with pytest.raises(Failed, match=r"actor 'bricks': colours changed, but a sync should only move vertices"):
+        checks.test_sync_keeps_the_mesh("brick_wall_single", kit("wrong_syncs:TintsMovingBodies"))
+
+
+def test_every_frame_vs_once_check_fails_on_a_double_buffered_sync():
+    with pytest.raises(AssertionError, match=r"drawn .* apart when synced every frame and when synced once after 10"):
+        checks.check_every_frame_equals_once(kit("wrong_syncs:OneStepLate"), "free_fall", {}, 10)
+    checks.check_every_frame_equals_once(kit("right_syncs:IncrementalSync"), "free_fall", {}, 10)
+
+
+def test_bounds_check_fails_on_inflated_bodies():
+    with pytest.raises(Failed, match=r"drawn box sticks out of getAABB by .* m along"):
+        checks.test_drawn_bounds_agree_with_get_aabb("free_fall", kit("wrong_syncs:InflatedAgainstZFighting"))
+
+
+def test_normals_check_fails_when_shared_sphere_normals_stay_put():
+    params = {"grouping": "by_kind", "count": 6, "seed": 3}
+    with pytest.raises(Failed, match=r"normal is turned .* rad from the body's rotated normal"):
+        checks.check_run(kit("wrong_syncs:NormalsNotRotated"), "mixed_shapes", params, 5)
+    checks.check_run(kit("reference"), "mixed_shapes", params, 5)
+
+
+def test_modified_check_fails_when_changes_are_not_announced():
+    with pytest.raises(Failed, match=r"actor 'bricks': the sync changed its vertex data at frame \d+ without marking it modified"):
+        checks.check_run(kit("wrong_syncs:ForgetsModified"), "brick_wall_single", {}, 2)
