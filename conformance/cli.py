@@ -122,27 +122,23 @@ def _cmd_verdicts(args, extra) -> int:
     outcomes = verdicts.check_all(args.specs, pytest_args=extra, jobs=args.jobs)
     text = verdicts.verdict_tables(outcomes)
     _emit(text, args.out)
+    if args.readme:
+        _replace_block(args.readme, "verdicts", text.split("\n\n")[0])  # the scene table
     return 0
 
 
 def _cmd_kill_rate(args, extra) -> int:
-    import importlib
-    import inspect
-
     from conformance import verdicts
 
-    def specs(module_name: str) -> list[str]:
-        module = importlib.import_module(module_name)
-        names = getattr(module, "__all__", None) or [
-            name for name, obj in vars(module).items()
-            if inspect.isclass(obj) and obj.__module__ == module_name and not name.startswith("_")]
-        return [f"{module_name}:{name}" for name in names]
-
-    wrong, right = specs(args.wrong), specs(args.right)
+    wrong, right = verdicts.implementations(args.wrong), verdicts.implementations(args.right)
     # A wrong implementation needs only its first failure; a right one must pass everything.
     outcomes = verdicts.check_all(wrong, stop_at_first=True, pytest_args=extra, jobs=args.jobs)
     accepted = verdicts.check_all(right, pytest_args=extra, jobs=args.jobs)
-    _emit(verdicts.kill_rate_table(outcomes, accepted), args.out)
+    summaries = {spec: verdicts.what_it_is(spec) for spec in wrong + right}
+    text = verdicts.kill_rate_table(outcomes, accepted, summaries)
+    _emit(text, args.out)
+    if args.readme:
+        _replace_block(args.readme, "kill-rate", text)
     return 0 if all(o.failed for o in outcomes) and all(o.passed for o in accepted) else 1
 
 
@@ -157,6 +153,24 @@ def _emit(text: str, out: str | None) -> None:
     print(text)
     if out:
         Path(out).write_text(text + "\n", encoding="utf-8")
+
+
+def _replace_block(path: str, name: str, text: str) -> None:
+    """Put ``text`` between the lines ``<!-- conformance:NAME -->`` and ``<!-- /conformance:NAME -->``
+    of the markdown file ``path`` (written whole, atomically)."""
+    start, end = f"<!-- conformance:{name} -->", f"<!-- /conformance:{name} -->"
+    target = Path(path)
+    try:
+        old = target.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ConformanceError(f"--readme {path!r}: cannot read it ({exc.strerror})") from None
+    if old.count(start) != 1 or old.count(end) != 1 or old.index(start) > old.index(end):
+        raise ConformanceError(f"--readme {path!r}: needs one line {start!r} followed by one line {end!r} "
+                               "around the place the table goes")
+    new = old[:old.index(start) + len(start)] + "\n" + text.strip() + "\n" + old[old.index(end):]
+    tmp = target.with_name(target.name + ".tmp")
+    tmp.write_text(new, encoding="utf-8")
+    tmp.replace(target)
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -190,12 +204,16 @@ def _parser() -> argparse.ArgumentParser:
     verdict.add_argument("specs", nargs="+", help="sync implementations (short names or module:attribute)")
     verdict.add_argument("--out", default=None, help="also write the markdown here")
     verdict.add_argument("--jobs", type=int, default=None, help="pytest processes at a time (default 1)")
+    verdict.add_argument("--readme", default=None, help="also put the scene table in this markdown file, between "
+                         "'<!-- conformance:verdicts -->' and '<!-- /conformance:verdicts -->'")
 
     kill = sub.add_parser("kill-rate", help="check every class of a module of wrong syncs and one of right syncs")
     kill.add_argument("--wrong", required=True, help="module whose classes are wrong sync implementations")
     kill.add_argument("--right", required=True, help="module whose classes are right sync implementations")
     kill.add_argument("--out", default=None, help="also write the markdown here")
     kill.add_argument("--jobs", type=int, default=None)
+    kill.add_argument("--readme", default=None, help="also put the table in this markdown file, between "
+                      "'<!-- conformance:kill-rate -->' and '<!-- /conformance:kill-rate -->'")
 
     doc = sub.add_parser("documented", help="measure pybullet against its documentation and print the table")
     doc.add_argument("--out", default=None, help="also write the markdown here")

@@ -170,7 +170,7 @@ def pytest_runtest_makereport(item: pytest.Item, call):
             "when": report.when,
             "outcome": "xfailed" if hasattr(report, "wasxfail") and report.skipped else report.outcome,
             "worst": item.stash.get(WORST, None),
-            "message": message.strip().splitlines()[0][:500] if message.strip() else "",
+            "message": message.strip().splitlines()[0][:4000] if message.strip() else "",
         })
     return report
 

@@ -14,6 +14,7 @@ from hypothesis import strategies as st
 from conformance.events import JointReset, Kick, Teleport
 
 __all__ = [
+    "HARD_ORIENTATIONS",
     "events",
     "frame_counts",
     "hard_orientations",

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import given, strategies as st
+from hypothesis import example, given, strategies as st
 
 from conformance import backends, compare, scenes, strategies
 from conformance.events import JointReset, Teleport
@@ -34,12 +34,33 @@ def check_run(kit, scene_name: str, params: dict, frames: int, events=()) -> Non
             kit.assert_frame(run)
 
 
+#: How far every body is lifted when it is turned again at frame 1 (so that it moves even if its turn does not).
+LIFT = (0.0, 0.0, 0.05)
+
+
 def turned_everything(scene_name: str, params: dict, turns) -> list:
-    """Frame-0 events turning every body, and every joint, to the orientations ``turns`` (cycled)."""
+    """Events turning every body, static ones too, and every joint to the orientations ``turns``
+    (cycled) at frame 0, before the first sync; and turning every body again (``turns`` reversed)
+    and lifting it a little at frame 1, after the first sync: a body the sync places once, or
+    only while it has velocity, is then drawn where it was."""
     with scenes.build(scene_name, **params) as probe:
         bodies = len({b.body for b in probe.bindings})
+    again = turns[::-1]
     events = [Teleport(0, i, (0.0, 0.0, 0.0), turns[i % len(turns)]) for i in range(bodies)]
-    return events + [JointReset(0, i, 1.0, turns[i % len(turns)]) for i in range(8)]
+    events += [JointReset(0, i, 1.0, turns[i % len(turns)]) for i in range(8)]
+    return events + [Teleport(1, i, LIFT, again[i % len(again)]) for i in range(bodies)]
+
+
+def with_scene_examples(scene_name: str, **fixed):
+    """Hypothesis ``@example``s of a check: the scene's defaults and each of its ``examples``
+    parameter sets (``SceneSpec.examples``), with the other arguments ``fixed``; tried first, every run."""
+
+    def decorate(check):
+        for params in ({}, *scenes.get(scene_name).examples):
+            check = example(params=dict(params), **fixed)(check)
+        return check
+
+    return decorate
 
 
 def check_every_frame_equals_once(kit, scene_name: str, params: dict, frames: int) -> None:
@@ -65,9 +86,11 @@ def check_every_frame_equals_once(kit, scene_name: str, params: dict, frames: in
 
 @each_scene()
 def test_vertices_match_poses_every_frame(scene_name, kit):
-    """The scene with its own parameters (the guide's, for the guide's scenes): every target, every
-    frame of the default run, from frame 0 (right after set-up) on."""
-    check_run(kit, scene_name, {}, min(scenes.get(scene_name).steps, 400))
+    """The scene with its own parameters (the guide's, for the guide's scenes), then with each of its
+    ``examples``: every target, every frame of the default run, from frame 0 (right after set-up) on."""
+    spec = scenes.get(scene_name)
+    for params in ({}, *spec.examples):
+        check_run(kit, scene_name, dict(params), min(spec.steps, 400))
 
 
 @each_scene()
@@ -89,9 +112,12 @@ def test_vertices_match_through_teleports_and_kicks(scene_name, kit):
 def test_vertices_match_in_every_orientation(scene_name, kit):
     """Every body teleported to an orientation drawn uniformly over rotations or from the cases that
     break sloppy code (identity, half turns, pitch at and near ±90°, negative w), every spherical
-    joint turned likewise, before the first sync; then a few frames of the motion that follows."""
+    joint turned likewise, before the first sync; every body turned again after it; then a few
+    frames of the motion that follows. Every hard case is always tried, on the scene's defaults and
+    on each of its ``examples``."""
 
     @check_settings(examples=5)
+    @with_scene_examples(scene_name, turns=list(strategies.HARD_ORIENTATIONS), frames=2)
     @given(params=strategies.scene_parameters(scene_name),
            turns=st.lists(strategies.orientations(), min_size=1, max_size=6),
            frames=st.integers(0, 3))

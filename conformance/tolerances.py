@@ -16,11 +16,13 @@ Vertex normals (stored for spheres) must point within ``normal_angle`` radians o
 rotated normals: float32 storage and pybullet's float32 helpers account for ~1e-6; we allow 1e-4.
 
 World bounds agree with ``getAABB`` when the drawn box lies inside pybullet's (within the vertex
-tolerance) and reaches it on every side within ``bounds_rtol`` (2.5 %) of the shape's size: FURY's
-spheres are tessellated with 16 segments, so in the worst direction their vertices reach
-cos(π/16) = 98.1 % of the radius. pybullet's box is exact for boxes and spheres; for cylinders, and
-for any shape it holds in a rotated local frame (a compound), it reports the box around the rotated
-bounding box, looser by up to (√3 − 1) of the size, so there ``loose_bounds_rtol`` (0.74) applies.
+tolerance) and reaches it on every side within ``bounds_rtol`` (2.5 %) of the shape's size, beyond
+the amount by which pybullet's box is itself larger than the shape: FURY's spheres are tessellated
+with 16 segments, so in the worst direction their vertices reach cos(π/16) = 98.1 % of the radius.
+pybullet's box is exact for boxes, and for spheres at their centre of mass; for cylinders, and for
+shapes off the centre of mass (a compound), it is a box around a turned box, up to 1.3× the
+shape's size larger (measured over random turns); the kit predicts that looseness from pybullet's
+pose (:func:`conformance.truth.aabb_half_extents`) rather than allowing it everywhere.
 """
 
 from __future__ import annotations
@@ -39,7 +41,6 @@ class Tolerance:
     atol: float = 1e-9
     normal_angle: float = 1e-4
     bounds_rtol: float = 0.025
-    loose_bounds_rtol: float = 0.74
 
     def for_geometry(self, local: np.ndarray, position) -> float:
         """Tolerance for a body whose link-frame geometry is ``local`` and whose frame is at ``position``."""

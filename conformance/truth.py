@@ -10,6 +10,9 @@ when the actor was built) moved by pybullet's pose of that link frame:
   forward kinematics recomputed so the pose is not one step stale.
 
 Nothing here reads a sync implementation's state or an actor.
+
+:func:`aabb_half_extents` predicts how loose pybullet's own ``getAABB`` is, so that the bounds check
+can hold the drawn box to it tightly.
 """
 
 from __future__ import annotations
@@ -17,13 +20,13 @@ from __future__ import annotations
 from typing import Sequence
 
 import numpy as np
-
+import pybullet
 from scipy.spatial.transform import Rotation
 
 from conformance import poses
 from conformance.client import BoundClient
 
-__all__ = ["link_frame", "link_frames", "expected_vertices"]
+__all__ = ["aabb_half_extents", "expected_vertices", "link_frame", "link_frames"]
 
 
 def link_frame(p: BoundClient, body: int, link: int) -> tuple[np.ndarray, np.ndarray]:
@@ -62,3 +65,33 @@ def link_frames(p: BoundClient, items: Sequence[tuple[int, int]]) -> tuple[np.nd
 def expected_vertices(local: np.ndarray, position, orientation) -> np.ndarray:
     """Reference geometry ``local`` (n, 3, link frame) placed at the given link-frame pose."""
     return poses.apply(position, orientation, local)
+
+
+def aabb_half_extents(p: BoundClient, body: int, link: int) -> np.ndarray:
+    """The half extents of the box ``getAABB(body, link)`` reports for a box, sphere or cylinder,
+    derived the way Bullet builds it (bullet3 ``btTransformAabb``, ``btCompoundShape::getAabb``):
+
+    * a box or cylinder is bounded by its own box (half extents ``h``, ``(r, r, h/2)``) turned with
+      the shape, ``|R|·h``: exact for a box, the box of a turned box for a cylinder; a sphere, exactly;
+    * a shape off its body's centre of mass (inertial offset, or a collision frame of its own) is the
+      child of a compound: the child's box, turned with the child frame, is turned again with the
+      centre-of-mass frame, ``|R_com|·|R_child|·h``, and a sphere's box becomes that of a turned cube.
+    """
+    shape = p.getCollisionShapeData(body, link)[0]
+    kind, dims, child_pos, child_orn = shape[2], shape[3], shape[5], shape[6]
+    if kind == pybullet.GEOM_BOX:
+        half = np.asarray(dims, dtype=np.float64) / 2
+    elif kind == pybullet.GEOM_CYLINDER:
+        half = np.array([dims[1], dims[1], dims[0] / 2])
+    elif kind == pybullet.GEOM_SPHERE:
+        half = np.full(3, float(dims[0]))
+    else:
+        raise ValueError(f"body {body} link {link}: shape type {kind} is not a box, sphere or cylinder")
+    com_orn = p.getBasePositionAndOrientation(body)[1] if link == -1 else p.getLinkState(body, link)[1]
+    turned = np.abs(Rotation.from_quat(com_orn).as_matrix())
+    compound = np.any(np.abs(child_pos) > 0) or not np.isclose(abs(child_orn[3]), 1.0)
+    if not compound:
+        return half if kind == pybullet.GEOM_SPHERE else turned @ half
+    if kind != pybullet.GEOM_SPHERE:
+        half = np.abs(Rotation.from_quat(child_orn).as_matrix()) @ half
+    return turned @ half

@@ -18,7 +18,7 @@ import tempfile
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 
-__all__ = ["Outcome", "check_all", "kill_rate_table", "verdict_tables"]
+__all__ = ["Outcome", "check", "check_all", "command", "implementations", "kill_rate_table", "verdict_tables", "what_it_is"]
 
 
 @dataclass
@@ -39,12 +39,52 @@ class Outcome:
         return self.exitstatus == 0
 
 
-def _run_one(spec: str, stop_at_first: bool, pytest_args: list[str]) -> Outcome:
+#: The Hypothesis profile of these runs unless the caller names one: derandomized, so a table can be
+#: regenerated, and unshrunk, so a wrong implementation is rejected at its first counter-example.
+PROFILE = "triage"
+
+
+def implementations(module_name: str) -> list[str]:
+    """``module:name`` specs of the sync implementations a module offers: its ``__all__``, else every
+    public class or function defined in it."""
+    import importlib
+    import inspect
+
+    module = importlib.import_module(module_name)
+    names = getattr(module, "__all__", None) or [
+        name for name, obj in vars(module).items()
+        if (inspect.isclass(obj) or inspect.isfunction(obj)) and obj.__module__ == module_name and not name.startswith("_")]
+    return [f"{module_name}:{name}" for name in names]
+
+
+def what_it_is(spec: str) -> str:
+    """One line on what an implementation is: the first clause of its docstring, without the
+    ``Wrong: ``/``Right: `` label that the kit's own examples start with."""
+    import inspect
+    import re
+
+    from conformance.sync import load
+
+    doc = inspect.getdoc(load(spec).factory) or ""
+    text = re.sub(r"^(Wrong|Right): ", "", " ".join(doc.split("\n\n")[0].split()))
+    end = re.search(r"(?<!i\.e)(: |\. )", text)
+    return (text[:end.start()] if end else text).replace("|", "/")
+
+
+def command(spec: str, *, stop_at_first: bool = False, pytest_args=(), report: str | None = None) -> list[str]:
+    """The pytest command line that checks ``spec`` (what a user would type, with ``python -m``)."""
+    profile = [] if any(a.startswith("--hypothesis-profile") for a in pytest_args) else ["--hypothesis-profile", PROFILE]
+    return [sys.executable, "-m", "pytest", "--pyargs", "conformance", "-m", "sync", "-q", "-p", "no:cacheprovider",
+            "--sync", spec, *profile, *(["--conformance-report", report] if report else []),
+            *(["-x"] if stop_at_first else []), *pytest_args]
+
+
+def check(spec: str, *, stop_at_first: bool = False, pytest_args=(), env=None) -> Outcome:
+    """Run the sync checks on ``spec`` in a pytest process of its own and read its report."""
     with tempfile.TemporaryDirectory() as tmp:
         report = os.path.join(tmp, "report.json")
-        argv = [sys.executable, "-m", "pytest", "--pyargs", "conformance", "-m", "sync", "-q", "-p", "no:cacheprovider",
-                "--sync", spec, "--conformance-report", report, *(["-x"] if stop_at_first else []), *pytest_args]
-        proc = subprocess.run(argv, capture_output=True, text=True)
+        argv = command(spec, stop_at_first=stop_at_first, pytest_args=list(pytest_args), report=report)
+        proc = subprocess.run(argv, capture_output=True, text=True, env=env)
         if not os.path.exists(report):
             return Outcome(spec, proc.returncode, [], (proc.stderr or proc.stdout)[-1500:])
         with open(report, encoding="utf-8") as fh:
@@ -52,12 +92,12 @@ def _run_one(spec: str, stop_at_first: bool, pytest_args: list[str]) -> Outcome:
         return Outcome(spec, proc.returncode, data["records"], proc.stderr[-1500:])
 
 
-def check_all(specs: list[str], *, stop_at_first: bool = False, pytest_args: list[str] = (), jobs: int | None = None) -> list[Outcome]:
-    """Run the sync checks for every spec, ``jobs`` processes at a time (default 1: VTK 9.3 aborts a
-    process that fails to get a GLX context, which llvmpipe does now and then when several
-    processes start rendering at once on a loaded machine)."""
+def check_all(specs: list[str], *, stop_at_first: bool = False, pytest_args: list[str] = (), jobs: int | None = None,
+              env=None) -> list[Outcome]:
+    """Run the sync checks for every spec, ``jobs`` processes at a time (default 1: the runs are
+    CPU-bound, so more processes than cores only slow each other); ``env`` is their environment."""
     with ThreadPoolExecutor(max_workers=jobs or 1) as pool:
-        return list(pool.map(lambda s: _run_one(s, stop_at_first, list(pytest_args)), specs))
+        return list(pool.map(lambda s: check(s, stop_at_first=stop_at_first, pytest_args=pytest_args, env=env), specs))
 
 
 def _cell(records: list[dict]) -> str:
@@ -102,19 +142,22 @@ def verdict_tables(outcomes: list[Outcome]) -> str:
     return "\n".join(lines)
 
 
-def kill_rate_table(wrong: list[Outcome], right: list[Outcome]) -> str:
-    """Markdown: each wrong implementation killed or not (by which check), each right one passing or not."""
+def kill_rate_table(wrong: list[Outcome], right: list[Outcome], summaries: dict[str, str] | None = None) -> str:
+    """Markdown: each wrong implementation killed or not (by which check), each right one passing or
+    not; ``summaries`` (spec -> one line) says what each implementation is."""
+    summaries = summaries or {}
     killed = [o for o in wrong if o.failed]
     lines = [f"Kill rate: {len(killed)}/{len(wrong)} wrong implementations rejected; "
              f"{sum(o.passed for o in right)}/{len(right)} right implementations accepted.", "",
-             "| implementation | expected | verdict | first failing check |", "|---|---|---|---|"]
+             "| implementation | what it is | verdict | first failing check |", "|---|---|---|---|"]
     for o in wrong:
         first = o.failed[0] if o.failed else None
         verdict = "killed" if first else ("ERROR" if o.exitstatus not in (0, 1) else "survived")
-        lines.append(f"| `{o.spec}` | wrong | {verdict} | {first['check'] + ' [' + str(first['scene']) + ']' if first else ''} |")
+        lines.append(f"| `{o.spec}` | {summaries.get(o.spec, 'wrong')} | {verdict} | "
+                     f"{first['check'] + ' [' + str(first['scene']) + ']' if first else ''} |")
     for o in right:
         first = o.failed[0] if o.failed else None
-        lines.append(f"| `{o.spec}` | right | {'passed' if o.passed else 'REJECTED'} | "
+        lines.append(f"| `{o.spec}` | {summaries.get(o.spec, 'right')} | {'passed' if o.passed else 'REJECTED'} | "
                      f"{first['check'] + ' [' + str(first['scene']) + ']' if first else ''} |")
     return "\n".join(lines)
 

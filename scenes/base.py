@@ -169,13 +169,22 @@ class Scene:
         actor: str | None = None,
         friction: float | None = None,
         restitution: float | None = None,
+        inertial_position: Sequence[float] = (0.0, 0.0, 0.0),
+        inertial_orientation: Sequence[float] = IDENTITY,
     ) -> int:
-        """Create a single-link body whose collision shape is ``shape`` and bind it for drawing."""
+        """Create a single-link body whose collision shape is ``shape`` and bind it for drawing.
+
+        ``position``/``orientation`` place the body's link frame (where ``shape`` is drawn from);
+        ``inertial_position``/``inertial_orientation`` place its centre of mass and principal axes in
+        that frame (pybullet's ``baseInertialFramePosition``/``Orientation``). pybullet's base pose
+        (``getBasePositionAndOrientation``) is the centre of mass's, not the link frame's."""
         body = self.p.createMultiBody(
             baseMass=mass,
             baseCollisionShapeIndex=shape.collision_shape(self.p),
             basePosition=list(position),
             baseOrientation=list(orientation),
+            baseInertialFramePosition=list(inertial_position),
+            baseInertialFrameOrientation=list(inertial_orientation),
         )
         dynamics = {}
         if friction is not None:

@@ -120,4 +120,5 @@ SPEC = SceneSpec(
     origin="canonical",
     description="Twelve spheres, boxes and cylinders, randomly sized and oriented, some thrown, fall onto a plate.",
     parameters=parameters,
+    examples=({"grouping": "by_kind"},),  # shared actors: vertex rewrites and stored normals
 )

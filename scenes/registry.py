@@ -26,6 +26,7 @@ _MODULES = (
     "bouncing_ball",
     "pendulum",
     "mixed_shapes",
+    "weighted",
     "tumbling",
     "crossing",
 )
@@ -51,12 +52,20 @@ class SceneSpec:
     parameters: Callable[[], Any] | None = None
     gravity: tuple[float, float, float] = (0.0, 0.0, -10.0)
     poster_step: int | None = None  # the frame that shows the scene best (README thumbnails); else `steps`
+    #: Parameter sets the property-based checks always try, besides the defaults: the variants that
+    #: exercise a different drawing path (e.g. shared actors) and must not be left to chance.
+    examples: tuple[Mapping[str, Any], ...] = ()
     defaults: Mapping[str, Any] = field(init=False)
 
     def __post_init__(self):
         params = inspect.signature(self.populate).parameters.values()
         defaults = {p.name: p.default for p in params if p.kind is inspect.Parameter.KEYWORD_ONLY}
         object.__setattr__(self, "defaults", defaults)
+        for example in self.examples:
+            unknown = sorted(set(example) - set(defaults))
+            if unknown:
+                raise InvalidArgument(f"SceneSpec {self.name!r}: examples has {example!r}, but "
+                                      f"{', '.join(map(repr, unknown))} is not a parameter of its populate()")
 
     def build(self, **params: Any) -> Scene:
         unknown = sorted(set(params) - set(self.defaults))

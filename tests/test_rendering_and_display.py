@@ -40,6 +40,47 @@ def test_virtual_display_is_started_and_stopped(monkeypatch):
     assert display._started is None and "DISPLAY" not in __import__("os").environ
 
 
+class _RefusingXlib:
+    """libX11 whose ``XOpenDisplay`` refuses the first ``refusals`` connections."""
+
+    def __init__(self, refusals):
+        self.refusals, self.opened, self.closed = refusals, 0, []
+
+    def XOpenDisplay(self, name):
+        self.opened += 1
+        return 0 if self.opened <= self.refusals else 0xD15
+
+    def XCloseDisplay(self, pointer):
+        self.closed.append(pointer)
+
+
+def test_x_connection_is_retried_until_the_server_answers(monkeypatch):
+    monkeypatch.setenv("DISPLAY", ":99")
+    xlib = _RefusingXlib(refusals=3)
+    monkeypatch.setattr(display, "_xlib", lambda: xlib)
+    monkeypatch.setattr(display, "CONNECT_PAUSE", 0.001)
+    assert display.x_connection() == 0xD15 and xlib.opened == 4
+    display.close_x_connection(0xD15)
+    assert xlib.closed == [0xD15]
+
+
+def test_x_connection_refused_every_time_is_a_clear_error_not_a_crash(monkeypatch):
+    monkeypatch.setenv("DISPLAY", ":99")
+    xlib = _RefusingXlib(refusals=100)
+    monkeypatch.setattr(display, "_xlib", lambda: xlib)
+    monkeypatch.setattr(display, "CONNECT_PAUSE", 0.001)
+    with pytest.raises(DisplayUnavailable, match=r"Could not connect to the X display ':99' \(8 attempts"):
+        display.x_connection()
+    assert xlib.opened == display.CONNECT_ATTEMPTS
+
+
+def test_x_connection_to_a_display_nobody_serves_fails_cleanly(monkeypatch):
+    monkeypatch.setenv("DISPLAY", ":4711")
+    monkeypatch.setattr(display, "CONNECT_ATTEMPTS", 2)
+    with pytest.raises(DisplayUnavailable, match="unset DISPLAY to let the kit start its own Xvfb"):
+        display.x_connection()
+
+
 def test_render_command_writes_the_png(tmp_path, capsys):
     out = tmp_path / "sub" / "ff.png"
     assert cli.main(["render", "free_fall", "--step", "10", "--size", "120", "90", "--out", str(out)]) == 0

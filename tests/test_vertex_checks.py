@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from conformance import sync
+from conformance import compare, sync
 from conformance import test_vertices as checks
 from conformance.events import Teleport
 from conformance.pytest_helpers import Kit
@@ -79,6 +79,25 @@ def test_every_frame_vs_once_check_fails_on_a_double_buffered_sync():
 def test_bounds_check_fails_on_inflated_bodies():
     with pytest.raises(Failed, match=r"drawn box sticks out of getAABB by .* m along"):
         checks.test_drawn_bounds_agree_with_get_aabb("free_fall", kit("wrong_syncs:InflatedAgainstZFighting"))
+
+
+def test_bounds_check_fails_on_shrunk_bodies_even_where_get_aabb_is_loose():
+    """Cylinders and bodies off their centre of mass, for which pybullet's box is larger than the shape."""
+    import wrong_syncs
+
+    class Shrunk(wrong_syncs.InflatedAgainstZFighting):
+        """Draws every body 5 % smaller than its collision shape."""
+
+        SCALE = 0.95
+
+    shrunk = sync.SyncImplementation(spec="Shrunk", target="tests:Shrunk", factory=Shrunk)
+    with pytest.raises(Failed, match=r"'ground': drawn box falls .* m short of getAABB along"):
+        checks.test_drawn_bounds_agree_with_get_aabb("weighted", Kit(shrunk, DEFAULT))
+    with Kit(shrunk, DEFAULT).run("weighted") as run:
+        run.advance(100)  # turned, and rocking on their loaded side
+        results = compare.compare_bounds(run.drawing, run.frame)
+    assert len(results) == 7 and all(any("short of getAABB" in p for p in r.problems) for r in results), results
+    checks.test_drawn_bounds_agree_with_get_aabb("weighted", kit("reference"))
 
 
 def test_normals_check_fails_when_shared_sphere_normals_stay_put():

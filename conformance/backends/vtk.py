@@ -16,7 +16,7 @@ from vtkmodules.util import numpy_support
 from vtkmodules.vtkCommonMath import vtkMatrix4x4
 
 from conformance import poses, truth
-from conformance.display import ensure_display, on_stop
+from conformance.display import close_x_connection, ensure_display, on_stop, x_connection
 from conformance.errors import SceneError
 from conformance.world import Target, World
 
@@ -193,17 +193,20 @@ def mesh_signature(actor) -> tuple[int, str, str]:
 
 
 _window = None  # one off-screen render window per process, created on first use
+_connection = None  # the X connection it renders through (VTK does not close one it did not open)
 
 
 def _render_window():
-    """The process's off-screen render window. VTK 9.3 aborts the whole process when it cannot
-    create a GLX context (seen on Mesa llvmpipe when several processes start rendering on a loaded
-    machine), so the kit creates one context per process and reuses it, instead of one per picture."""
-    global _window
+    """The process's off-screen render window, made once and reused for every picture. VTK 9.3 calls
+    ``abort()`` when its own ``XOpenDisplay`` fails, so the window is handed a connection that
+    :func:`conformance.display.x_connection` opened with retries."""
+    global _window, _connection
     if _window is None:
         from fury import window
 
+        _connection = x_connection()
         _window = window.RenderWindow()
+        _window.SetDisplayId(f"_{_connection:016x}_p_void")  # VTK's spelling of a void* argument
         _window.SetOffScreenRendering(1)
         _window.SetMultiSamples(8)
         on_stop(_release_window)
@@ -211,10 +214,13 @@ def _render_window():
 
 
 def _release_window() -> None:
-    global _window
+    global _window, _connection
     if _window is not None:
         _window.Finalize()
         _window = None
+    if _connection is not None:
+        close_x_connection(_connection)
+        _connection = None
 
 
 def render(drawing: Drawing, camera, size: tuple[int, int], background=(1.0, 1.0, 1.0)) -> np.ndarray:

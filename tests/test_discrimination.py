@@ -1,0 +1,91 @@
+"""The kit's proof that it discriminates: it fails every deliberately wrong sync and passes every right one.
+
+Each implementation is checked end to end, the way a user runs the kit and the way the README's
+kill-rate table is made (``python -m conformance kill-rate``, :mod:`conformance.verdicts`)::
+
+    python -m pytest --pyargs conformance -m sync -q --sync wrong_syncs:<Name> --hypothesis-profile triage -x
+
+in its own process (``tests/`` on ``PYTHONPATH``). A wrong one must make pytest exit 1 (checks
+failed; not 2, 3 or 4, which are errors) with a failure that names the scene and frame
+(``[scene(params), frame N, …]``); a right one must make the same command without ``-x`` exit 0.
+The ``triage`` profile is derandomized, so every run of this file tries the same examples.
+
+The runs start together, one per core, when the first of them is needed.
+"""
+
+from __future__ import annotations
+
+import inspect
+import os
+import re
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import pytest
+
+import right_syncs
+import wrong_syncs
+from conformance import scenes, verdicts
+
+TESTS = Path(__file__).resolve().parent
+WRONG = verdicts.implementations("wrong_syncs")
+RIGHT = verdicts.implementations("right_syncs")
+
+#: How the kit's failure messages name where it went wrong: ``[scene(params), frame N`` or ``[scene, frame N``.
+WHERE = re.compile(r"\[(?P<scene>[A-Za-z_][A-Za-z0-9_]*)(?:\(.*?\))?, frame (?P<frame>\d+)")
+
+
+def _describe(outcome: verdicts.Outcome, stop_at_first: bool) -> str:
+    failures = "\n".join(f"  {r['check']} [{r['scene']}]: {r['message'][:400]}" for r in outcome.failed[:3])
+    argv = verdicts.command(outcome.spec, stop_at_first=stop_at_first)
+    return (f"`PYTHONPATH=tests {' '.join(argv[1:])}` exited {outcome.exitstatus}; "
+            f"{len(outcome.failed)} checks failed{':' if failures else '.'}\n{failures}\n{outcome.stderr[-800:]}")
+
+
+@pytest.fixture(scope="module")
+def runs(request):
+    """Start every selected implementation's run at once (``os.cpu_count()`` at a time); spec -> Future."""
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join([str(TESTS), *filter(None, env.get("PYTHONPATH", "").split(os.pathsep))])
+    env.pop("CONFORMANCE_SYNC", None)
+    wanted = {}
+    for item in request.session.items:
+        callspec = getattr(item, "callspec", None)
+        if item.module is request.module and callspec is not None and "spec" in callspec.params:
+            wanted[callspec.params["spec"]] = item.originalname == "test_kit_fails_a_wrong_sync"
+    with ThreadPoolExecutor(max_workers=max(1, min(len(wanted), os.cpu_count() or 1))) as pool:
+        futures = {spec: pool.submit(verdicts.check, spec, stop_at_first=wrong, env=env) for spec, wrong in wanted.items()}
+        try:
+            yield futures
+        finally:
+            for future in futures.values():
+                future.cancel()
+
+
+@pytest.mark.parametrize("spec", [pytest.param(s, id=s.partition(":")[2]) for s in WRONG])
+def test_kit_fails_a_wrong_sync(spec, runs):
+    outcome = runs[spec].result()
+    assert outcome.exitstatus == pytest.ExitCode.TESTS_FAILED and outcome.failed, (
+        f"the kit should fail the wrong sync {spec} (exit 1), but {_describe(outcome, True)}")
+    where = [m for r in outcome.failed for m in WHERE.finditer(r["message"]) if m["scene"] in scenes.names()]
+    assert where, f"the failure of {spec} does not name a scene and frame as '[scene(params), frame N': {_describe(outcome, True)}"
+
+
+@pytest.mark.parametrize("spec", [pytest.param(s, id=s.partition(":")[2]) for s in RIGHT])
+def test_kit_passes_a_right_sync(spec, runs):
+    outcome = runs[spec].result()
+    assert outcome.exitstatus == pytest.ExitCode.OK, f"the kit should pass the right sync {spec}, but {_describe(outcome, False)}"
+
+
+def test_every_wrong_and_right_implementation_is_checked():
+    """A new public class or function in ``wrong_syncs`` or ``right_syncs`` is in its ``__all__``, so it
+    is checked here and counted in the kill rate; each says what it is."""
+    for module, minimum, word in ((wrong_syncs, 10, "Wrong: "), (right_syncs, 3, "Right: ")):
+        public = {n for n, o in vars(module).items() if (inspect.isclass(o) or inspect.isfunction(o))
+                  and o.__module__ == module.__name__ and not n.startswith("_")}
+        listed = set(module.__all__)
+        assert public <= listed, f"{module.__name__} defines {sorted(public - listed)}, missing from its __all__"
+        assert len(listed) >= minimum
+        for name in listed:
+            doc = inspect.getdoc(getattr(module, name)) or ""
+            assert doc.startswith(word), f"{module.__name__}.{name}'s docstring should start {word!r}<what it is>"

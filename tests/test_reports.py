@@ -1,0 +1,65 @@
+"""The verdict and kill-rate tables: what they say, and how they land in the README."""
+
+from __future__ import annotations
+
+import pytest
+
+from conformance import cli, verdicts
+from conformance.errors import ConformanceError
+
+
+def _record(check, scene, outcome, ratio=None):
+    worst = {"ratio": ratio, "error": ratio * 1e-6} if ratio is not None else None
+    return {"check": check, "scene": scene, "outcome": outcome, "worst": worst,
+            "message": f"x is off [{scene}, frame 3, sync 'w']" if outcome == "failed" else ""}
+
+
+def test_kill_rate_table_counts_survivors_and_rejected_right_ones():
+    wrong = [verdicts.Outcome("w:Killed", 1, [_record("test_a", "free_fall", "failed")]),
+             verdicts.Outcome("w:Survivor", 0, [_record("test_a", "free_fall", "passed")]),
+             verdicts.Outcome("w:Broken", 4, [])]
+    right = [verdicts.Outcome("r:Good", 0, [_record("test_a", "chain", "passed")]),
+             verdicts.Outcome("r:Bad", 1, [_record("test_b", "chain", "failed")])]
+    table = verdicts.kill_rate_table(wrong, right, {"w:Killed": "Wrong: forgets a body"})
+    assert table.startswith("Kill rate: 1/3 wrong implementations rejected; 1/2 right implementations accepted.")
+    assert "| `w:Killed` | Wrong: forgets a body | killed | test_a [free_fall] |" in table
+    assert "| `w:Survivor` | wrong | survived |  |" in table
+    assert "| `w:Broken` | wrong | ERROR |  |" in table
+    assert "| `r:Bad` | right | REJECTED | test_b [chain] |" in table
+
+
+def test_verdict_table_marks_failures_with_the_worst_error():
+    outcomes = [verdicts.Outcome("ok", 0, [_record("test_a", "chain", "passed", 0.5)]),
+                verdicts.Outcome("bad", 1, [_record("test_a", "chain", "failed", 3e4), _record("test_b", "chain", "passed")])]
+    table = verdicts.verdict_tables(outcomes)
+    assert "| chain | ✓ 5.0e-07 m (0.5×tol) | ✗ 1/2 3.0e-02 m (3e+04×tol) |" in table
+    assert "- `bad` · `test_a` [chain]: x is off [chain, frame 3, sync 'w']" in table
+
+
+def test_implementations_are_the_modules_public_list():
+    assert verdicts.implementations("right_syncs")[:2] == ["right_syncs:IncrementalSync", "right_syncs:PerTargetSync"]
+    assert "right_syncs:vectorised_vertex_sync" in verdicts.implementations("right_syncs")
+
+
+def test_what_an_implementation_is_comes_from_its_docstring():
+    assert verdicts.what_it_is("wrong_syncs:VelocityGated") == (
+        'after the first frame, skips bodies whose velocity is exactly zero ("a body at rest has not moved")')
+    assert verdicts.what_it_is("right_syncs:UserMatrixSync").startswith("per-actor user matrices")
+
+
+def test_tables_replace_only_their_block_of_the_readme(tmp_path):
+    readme = tmp_path / "README.md"
+    readme.write_text("intro\n<!-- conformance:kill-rate -->\nold table\n<!-- /conformance:kill-rate -->\nrest\n")
+    cli._replace_block(str(readme), "kill-rate", "| new |\n")
+    assert readme.read_text() == "intro\n<!-- conformance:kill-rate -->\n| new |\n<!-- /conformance:kill-rate -->\nrest\n"
+    assert not (tmp_path / "README.md.tmp").exists()
+
+
+def test_readme_without_the_markers_is_a_clear_error_and_is_left_alone(tmp_path):
+    readme = tmp_path / "README.md"
+    readme.write_text("no markers here\n")
+    with pytest.raises(ConformanceError, match=r"needs one line '<!-- conformance:verdicts -->' followed by"):
+        cli._replace_block(str(readme), "verdicts", "| t |")
+    assert readme.read_text() == "no markers here\n"
+    with pytest.raises(ConformanceError, match=r"cannot read it"):
+        cli._replace_block(str(tmp_path / "missing.md"), "verdicts", "| t |")
