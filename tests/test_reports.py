@@ -63,3 +63,17 @@ def test_readme_without_the_markers_is_a_clear_error_and_is_left_alone(tmp_path)
     assert readme.read_text() == "no markers here\n"
     with pytest.raises(ConformanceError, match=r"cannot read it"):
         cli._replace_block(str(tmp_path / "missing.md"), "verdicts", "| t |")
+
+
+def test_run_command_is_pytest_on_the_kit_and_says_so_in_its_exit_status(monkeypatch, capfd):
+    """``python -m conformance run`` (what ``./kit run`` calls): 0 for a right sync, 1 for a wrong one,
+    and no warning that the kit could not be assert-rewritten."""
+    from pathlib import Path
+
+    monkeypatch.setenv("PYTHONPATH", str(Path(__file__).parent))
+    select = ["-q", "-k", "free_fall and poses_every_frame"]
+    assert cli.main(["run", "--sync", "right_syncs:PerTargetSync", *select]) == 0
+    assert cli.main(["run", "--sync", "wrong_syncs:DoesNothing", *select]) == 1
+    out, err = capfd.readouterr()
+    assert "1 passed" in out and "1 failed" in out and "[free_fall" in out
+    assert "PytestAssertRewriteWarning" not in out + err
