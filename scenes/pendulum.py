@@ -5,6 +5,10 @@ frame (getLinkState[0:2]): each link frame sits at its hinge while its centre of
 drawn there, hangs ``length`` below it. The inertial frame is also turned, so a sync that mixes
 the link position with the COM orientation is caught too. Damping and pybullet's default joint
 motors are off, so the swing keeps its energy and its period is the textbook one.
+
+With ``pendulums`` > 1 there are several such multibodies side by side (one behind the other along
+y, each released from a larger angle), so every link index names a link of several bodies; with
+``shared`` their bobs are drawn by one shared actor (the guide's joint recipe).
 """
 
 from __future__ import annotations
@@ -27,9 +31,20 @@ BOB_COLORS = ((0.85, 0.2, 0.2), (0.2, 0.6, 0.3))
 
 
 def populate(scene: Scene, *, length: float = 1.0, radius: float = 0.15, mass: float = 1.0,
-             angle: float = 0.6, links: int = 1) -> None:
+             angle: float = 0.6, links: int = 1, pendulums: int = 1, shared: bool = False) -> None:
     if links not in (1, 2):
         raise InvalidArgument(f"links={links!r}, but should be 1 or 2")
+    if not 1 <= pendulums <= 8:
+        raise InvalidArgument(f"pendulums={pendulums!r}, but should be 1 to 8")
+    spacing = max(0.5, 4 * radius)  # along y, across the swing plane: neighbours never touch
+    for i in range(pendulums):
+        _pendulum(scene, suffix="" if i == 0 else f"_{i + 1}", y=(i - (pendulums - 1) / 2) * spacing,
+                  length=length, radius=radius, mass=mass, angle=angle + 0.3 * i, links=links,
+                  actor="bobs" if shared else None)
+
+
+def _pendulum(scene: Scene, *, suffix: str, y: float, length: float, radius: float, mass: float, angle: float,
+              links: int, actor: str | None) -> None:
     p = scene.p
     mount = Shape("box", MOUNT, color=(0.5, 0.5, 0.5))
     bobs = [Shape("sphere", (radius,), color=BOB_COLORS[i], position=(0.0, 0.0, -length)) for i in range(links)]
@@ -37,7 +52,7 @@ def populate(scene: Scene, *, length: float = 1.0, radius: float = 0.15, mass: f
     body = p.createMultiBody(
         baseMass=0.0,
         baseCollisionShapeIndex=mount.collision_shape(p),
-        basePosition=[PIVOT[0], PIVOT[1], PIVOT[2] + MOUNT[2]],
+        basePosition=[PIVOT[0], PIVOT[1] + y, PIVOT[2] + MOUNT[2]],
         baseOrientation=list(IDENTITY),
         linkMasses=[mass] * links,
         linkCollisionShapeIndices=[bob.collision_shape(p) for bob in bobs],
@@ -62,9 +77,9 @@ def populate(scene: Scene, *, length: float = 1.0, radius: float = 0.15, mass: f
         # Every revolute joint starts with a velocity motor holding it still; force 0 frees it.
         p.setJointMotorControl2(body, link, pybullet.VELOCITY_CONTROL, targetVelocity=0, force=0)
     p.resetJointState(body, 0, angle)
-    scene.bind("mount", body, -1, mount)
+    scene.bind(f"mount{suffix}", body, -1, mount)
     for link, bob in enumerate(bobs):
-        scene.bind(f"bob{link + 1}", body, link, bob)
+        scene.bind(f"bob{link + 1}{suffix}", body, link, bob, actor=actor)
 
 
 def parameters():
@@ -76,6 +91,8 @@ def parameters():
         "mass": st.floats(0.1, 10.0),
         "angle": st.floats(-1.5, 1.5),
         "links": st.sampled_from([1, 2]),
+        "pendulums": st.integers(1, 3),
+        "shared": st.booleans(),
     })
 
 
@@ -90,4 +107,6 @@ SPEC = SceneSpec(
     poster_step=60,
     description="A bob on a 1 m massless arm, hinged about y to a fixed mount, swings from 0.6 rad without losses.",
     parameters=parameters,
+    # Several multibodies whose links share indices, drawn whole and by a shared actor.
+    examples=({"pendulums": 3, "links": 2}, {"pendulums": 3, "links": 2, "shared": True}),
 )

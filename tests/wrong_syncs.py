@@ -25,6 +25,7 @@ __all__ = [
     "ConjugateQuaternion",
     "DoesNothing",
     "EulerRotateXYZ",
+    "FirstMultibodyOnly",
     "Float32Incremental",
     "ForgetsModified",
     "IgnoresBaseInertialFrame",
@@ -119,6 +120,21 @@ class StaleLinkState(Baseline):
     def link_pose(self, t):
         if t.link >= 0:
             return self.p.getLinkState(t.body, t.link)[4:6]
+        return super().link_pose(t)
+
+
+class FirstMultibodyOnly(Baseline):
+    """Wrong: reads every link's pose from the first body that has links (the guide's sync_joints
+    takes one global ``multibody``; adapted to a scene with several robots, link ``i`` of each is
+    drawn where link ``i`` of the first one is)."""
+
+    def __init__(self, world):
+        super().__init__(world)
+        self.multibody = next((t.body for t in self.targets if t.link >= 0), None)
+
+    def link_pose(self, t):
+        if t.link >= 0:
+            return self.p.getLinkState(self.multibody, t.link, computeForwardKinematics=1)[4:6]
         return super().link_pose(t)
 
 
