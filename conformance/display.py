@@ -15,6 +15,7 @@ import atexit
 import contextlib
 import ctypes
 import ctypes.util
+import functools
 import os
 import shutil
 import time
@@ -74,6 +75,7 @@ def stop_display() -> None:
         display.stop()
 
 
+@functools.cache  # loaded once: opening and closing a connection both need it
 def _xlib():
     path = ctypes.util.find_library("X11")
     if path is None:

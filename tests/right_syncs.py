@@ -312,13 +312,16 @@ class PerTargetSync:
         for actor in actors:
             utils.update_actor(actor)  # marks points and every point-data array (normals too) modified
 
-    def __call__(self):
+    def draw(self, posed) -> None:
+        """Place each ``(target, position, orientation)`` and finish the shared actors written."""
         touched = {}
-        for t in self.to_sync():
-            pos, orn = self.link_pose(t)
+        for t, pos, orn in posed:
             if t.shared:
                 self.place_shared(t, pos, orn)
                 touched[id(t.actor)] = t.actor
             else:
                 self.place_whole(t, pos, orn)
         self.finish(touched.values())
+
+    def __call__(self):
+        self.draw((t, *self.link_pose(t)) for t in self.to_sync())

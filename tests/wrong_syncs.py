@@ -163,15 +163,7 @@ class OneStepLate(Baseline):
     def __call__(self):
         current = {t.name: self.link_pose(t) for t in self.targets}
         shown = self.previous or current
-        touched = {}
-        for t in self.targets:
-            pos, orn = shown[t.name]
-            if t.shared:
-                self.place_shared(t, pos, orn)
-                touched[id(t.actor)] = t.actor
-            else:
-                self.place_whole(t, pos, orn)
-        self.finish(touched.values())
+        self.draw((t, *shown[t.name]) for t in self.targets)
         self.previous = current
 
 
