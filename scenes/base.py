@@ -85,9 +85,34 @@ class Binding:
 
 @dataclass(frozen=True)
 class Camera:
+    """Where a scene is seen from, every number explicit so two renderers can be given the same view.
+
+    ``view_angle`` is the vertical field of view in degrees (VTK's ``SetViewAngle`` with its default
+    vertical convention; pyBullet's ``computeProjectionMatrixFOV(fov=…)``); ``clipping_range`` is
+    ``(near, far)`` in metres from the camera, set explicitly rather than reset to the scene's bounds
+    by the renderer, so a body moving away cannot change the depth precision of another's picture.
+    """
+
     position: tuple[float, float, float]
     focal_point: tuple[float, float, float]
     view_up: tuple[float, float, float]
+    view_angle: float = 30.0
+    clipping_range: tuple[float, float] = (0.1, 100.0)
+
+    def __post_init__(self):
+        for name in ("position", "focal_point", "view_up"):
+            value = getattr(self, name)
+            if len(value) != 3 or not all(math.isfinite(v) for v in value):
+                raise InvalidArgument(f"Camera {name}={value!r}, but should be three finite numbers")
+        if not 0 < self.view_angle < 180:
+            raise InvalidArgument(f"Camera view_angle={self.view_angle!r}, but should be in degrees, between 0 and 180")
+        near, far = self.clipping_range
+        if not 0 < near < far:
+            raise InvalidArgument(f"Camera clipping_range={self.clipping_range!r}, but should be (near, far) with 0 < near < far")
+
+    def as_dict(self) -> dict:
+        return {"position": list(self.position), "focal_point": list(self.focal_point), "view_up": list(self.view_up),
+                "view_angle": self.view_angle, "clipping_range": list(self.clipping_range)}
 
 
 @dataclass(frozen=True)

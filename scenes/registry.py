@@ -52,6 +52,13 @@ class SceneSpec:
     parameters: Callable[[], Any] | None = None
     gravity: tuple[float, float, float] = (0.0, 0.0, -10.0)
     poster_step: int | None = None  # the frame that shows the scene best (README thumbnails); else `steps`
+    #: Frames with golden snapshots: the first, one in the middle of the action (the poster frame,
+    #: else half-way) and the last, unless the scene names its own.
+    golden_frames: tuple[int, ...] | None = None
+    #: The step after which the scene's physics is chaotic (a whip, a pile): small platform
+    #: differences in floating point grow there, so a golden's stored physics state may not be
+    #: reproduced on another machine. None: the scene is expected to reproduce everywhere.
+    chaotic_after: int | None = None
     #: Parameter sets the property-based checks always try, besides the defaults: the variants that
     #: exercise a different drawing path (e.g. shared actors) and must not be left to chance.
     examples: tuple[Mapping[str, Any], ...] = ()
@@ -66,6 +73,12 @@ class SceneSpec:
             if unknown:
                 raise InvalidArgument(f"SceneSpec {self.name!r}: examples has {example!r}, but "
                                       f"{', '.join(map(repr, unknown))} is not a parameter of its populate()")
+
+    def frames_with_goldens(self) -> tuple[int, ...]:
+        if self.golden_frames is not None:
+            return tuple(self.golden_frames)
+        middle = self.poster_step if self.poster_step is not None else self.steps // 2
+        return tuple(sorted({0, middle, self.steps}))
 
     def build(self, **params: Any) -> Scene:
         unknown = sorted(set(params) - set(self.defaults))

@@ -7,13 +7,14 @@ The rest of the kit talks to a backend only through these functions:
 * ``world_normals(actor)``: the stored vertex normals as they will be lit, or None;
 * ``mesh_signature(actor)``: vertex count, topology and colours, to check a sync keeps the mesh;
 * ``content_state(actor)``: modification time and data digest, to check changes are announced;
-* ``render(drawing, camera, size) -> (h, w, 3) uint8``: an off-screen picture.
+* ``render(drawing, camera, size, *, multisamples) -> (h, w, 3) uint8``: an off-screen picture;
+* ``renderer_info() -> dict``: what draws the pictures (OpenGL vendor/renderer/version, VTK version).
 
 FURY 0.12 (VTK) is the only backend today; FURY 2.x (pygfx) would be a sibling module.
 """
 
 from __future__ import annotations
 
-from .vtk import Drawing, build, content_state, mesh_signature, render, world_normals, world_vertices
+from .vtk import Drawing, build, content_state, mesh_signature, render, renderer_info, world_normals, world_vertices
 
-__all__ = ["Drawing", "build", "content_state", "mesh_signature", "render", "world_normals", "world_vertices"]
+__all__ = ["Drawing", "build", "content_state", "mesh_signature", "render", "renderer_info", "world_normals", "world_vertices"]

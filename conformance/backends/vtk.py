@@ -20,7 +20,7 @@ from conformance.display import close_x_connection, ensure_display, on_stop, x_c
 from conformance.errors import SceneError
 from conformance.world import Target, World
 
-__all__ = ["Drawing", "build", "content_state", "mesh_signature", "render", "world_normals", "world_vertices"]
+__all__ = ["Drawing", "build", "content_state", "mesh_signature", "render", "renderer_info", "world_normals", "world_vertices"]
 
 IDENTITY_POSITION = np.zeros(3)
 IDENTITY_ORIENTATION = np.array([0.0, 0.0, 0.0, 1.0])
@@ -192,6 +192,9 @@ def mesh_signature(actor) -> tuple[int, str, str]:
     return data.GetNumberOfPoints(), cells.hexdigest(), color_digest
 
 
+#: Anti-aliasing samples of every picture unless a caller asks otherwise.
+MULTISAMPLES = 8
+
 _window = None  # one off-screen render window per process, created on first use
 _connection = None  # the X connection it renders through (VTK does not close one it did not open)
 
@@ -208,7 +211,7 @@ def _render_window():
         _window = window.RenderWindow()
         _window.SetDisplayId(f"_{_connection:016x}_p_void")  # VTK's spelling of a void* argument
         _window.SetOffScreenRendering(1)
-        _window.SetMultiSamples(8)
+        _window.SetMultiSamples(MULTISAMPLES)
         on_stop(_release_window)
     return _window
 
@@ -223,8 +226,14 @@ def _release_window() -> None:
         _connection = None
 
 
-def render(drawing: Drawing, camera, size: tuple[int, int], background=(1.0, 1.0, 1.0)) -> np.ndarray:
-    """An off-screen picture of the drawing, ``(height, width, 3)`` uint8, top row first."""
+def render(drawing: Drawing, camera, size: tuple[int, int], *, background=(1.0, 1.0, 1.0),
+           multisamples: int = MULTISAMPLES) -> np.ndarray:
+    """An off-screen picture of the drawing, ``(height, width, 3)`` uint8, top row first.
+
+    The camera is applied whole (position, focal point, view up, vertical view angle and the clipping
+    range, which is set after FURY's ``set_camera`` resets it to the scene's bounds). The light is
+    VTK's default headlight, which follows the camera; ``multisamples`` is the anti-aliasing.
+    """
     ensure_display()
     from fury import window
 
@@ -233,7 +242,11 @@ def render(drawing: Drawing, camera, size: tuple[int, int], background=(1.0, 1.0
     for actor in drawing.actors.values():
         stage.add(actor)
     stage.set_camera(position=camera.position, focal_point=camera.focal_point, view_up=camera.view_up)
+    vtk_camera = stage.GetActiveCamera()
+    vtk_camera.SetViewAngle(camera.view_angle)
+    vtk_camera.SetClippingRange(*camera.clipping_range)
     render_window = _render_window()
+    render_window.SetMultiSamples(multisamples)
     render_window.AddRenderer(stage)
     render_window.SetSize(*size)
     try:
@@ -242,3 +255,21 @@ def render(drawing: Drawing, camera, size: tuple[int, int], background=(1.0, 1.0
     finally:
         render_window.RemoveRenderer(stage)
         stage.clear()
+
+
+def renderer_info() -> dict[str, str]:
+    """What draws the pictures: the OpenGL vendor, renderer and version strings as VTK reports them,
+    and the VTK version (a golden made by another renderer is judged with looser tolerances)."""
+    from vtkmodules.vtkCommonCore import vtkVersion
+
+    ensure_display()
+    window = _render_window()
+    if "OpenGL renderer string" not in window.ReportCapabilities():
+        window.Render()  # the context, and so the strings, exist only once something was drawn
+    info = {"backend": "vtk", "vtk": vtkVersion.GetVTKVersion()}
+    for line in window.ReportCapabilities().splitlines():
+        key, _, value = line.partition(":")
+        for name in ("vendor", "renderer", "version"):
+            if key.strip() == f"OpenGL {name} string":
+                info[f"gl_{name}"] = value.strip()
+    return info
