@@ -7,7 +7,8 @@
   by frame and print each frame's worst error (what a failing check's "reproduce:" line runs);
 * ``verdicts SPEC…``: the checks against several syncs, as markdown verdict tables;
 * ``kill-rate --wrong MODULE --right MODULE``: how many deliberately wrong syncs the checks reject;
-* ``documented``: pybullet's behaviour measured against its documentation, as a markdown table.
+* ``documented``: pybullet's behaviour measured against its documentation, as a markdown table;
+* ``regen [SCENE…] [--missing | --failing]``: make golden snapshots anew and say what changed.
 """
 
 from __future__ import annotations
@@ -141,6 +142,27 @@ def _cmd_kill_rate(args, extra) -> int:
     return 0 if all(o.failed for o in outcomes) and all(o.passed for o in accepted) else 1
 
 
+def _cmd_regen(args, extra) -> int:
+    from conformance import scenes
+    from conformance.display import virtual_display
+    from conformance.rendering import golden, snapshots
+
+    names = args.scene or scenes.names()
+    for name in names:
+        scenes.get(name)  # an unknown name fails before anything is rendered or written
+    directory = Path(args.golden_dir) if args.golden_dir else golden.default_dir()
+    mode = "missing" if args.missing else "failing" if args.failing else "all"
+    counts = {"new": 0, "changed": 0, "unchanged": 0}
+    with virtual_display():
+        for name in names:
+            for change in snapshots.regenerate(name, directory, mode=mode):
+                counts[change.status] += 1
+                print(change.describe())
+    print(f"goldens in {directory}: {counts['new']} new, {counts['changed']} changed, {counts['unchanged']} unchanged"
+          + ("" if mode == "all" else f" (only {mode} ones were made)"))
+    return 0
+
+
 def _cmd_documented(args, extra) -> int:
     from conformance import documented
 
@@ -214,6 +236,14 @@ def _parser() -> argparse.ArgumentParser:
     kill.add_argument("--readme", default=None, help="also put the table in this markdown file, between "
                       "'<!-- conformance:kill-rate -->' and '<!-- /conformance:kill-rate -->'")
 
+    regen = sub.add_parser("regen", help="make golden snapshots anew (reference sync), atomically; print what changed")
+    regen.add_argument("scene", nargs="*", help="scene names (default: every scene)")
+    which = regen.add_mutually_exclusive_group()
+    which.add_argument("--missing", action="store_true", help="only goldens that are missing or unreadable")
+    which.add_argument("--failing", action="store_true", help="only goldens that are missing, unreadable or fail "
+                       "the render check with the reference sync")
+    regen.add_argument("--golden-dir", default=None, help="directory of goldens (default: the kit's own)")
+
     doc = sub.add_parser("documented", help="measure pybullet against its documentation and print the table")
     doc.add_argument("--out", default=None, help="also write the markdown here")
     return parser
@@ -228,7 +258,8 @@ def main(argv: list[str] | None = None) -> int:
     if hasattr(args, "sync"):
         args.sync = resolve_spec(args.sync)
     handler = {"run": _cmd_run, "scenes": _cmd_scenes, "render": _cmd_render, "check": _cmd_check,
-               "verdicts": _cmd_verdicts, "kill-rate": _cmd_kill_rate, "documented": _cmd_documented}[args.command]
+               "verdicts": _cmd_verdicts, "kill-rate": _cmd_kill_rate, "documented": _cmd_documented,
+               "regen": _cmd_regen}[args.command]
     try:
         return handler(args, extra)
     except ConformanceError as err:

@@ -10,6 +10,10 @@ from __future__ import annotations
 __all__ = [
     "ConformanceError",
     "DisplayUnavailable",
+    "GoldenError",
+    "GoldenMissing",
+    "GoldenUnreadable",
+    "ImageSizeMismatch",
     "InvalidArgument",
     "SceneError",
     "SyncError",
@@ -49,3 +53,21 @@ class SyncProtocolError(SyncError):
 
 class SyncRaised(SyncError):
     """The sync implementation raised while the kit was running it."""
+
+
+class GoldenError(ConformanceError):
+    """A golden snapshot or its manifest cannot be used as it is; the message names the file and the
+    command that makes it anew. Nothing is written when this is raised."""
+
+
+class GoldenMissing(GoldenError):
+    """No golden (or no manifest beside it) exists for a scene's frame."""
+
+
+class GoldenUnreadable(GoldenError):
+    """A golden is not a PNG, is truncated, has the wrong size, or its manifest is malformed or was
+    made for other scene parameters, another frame, or another camera."""
+
+
+class ImageSizeMismatch(GoldenError):
+    """A render and its golden differ in size: re-record the golden rather than compare pixels."""

@@ -9,6 +9,13 @@ Options live under one group, each mirrored by an ini setting:
   of :mod:`conformance.tolerances`.
 * ``--conformance-report PATH`` / ``conformance_report``: write every check's outcome, scene and
   worst measured error as JSON (what ``python -m conformance verdicts`` reads).
+* Pictures (:mod:`conformance.image_options` reads and validates them):
+  ``--conformance-golden-dir DIR`` / ``conformance_golden_dir`` (default: the kit's own goldens),
+  ``--conformance-image-tolerance auto|same-renderer|other-renderer`` / ``conformance_image_tolerance``,
+  ``--conformance-results DIR`` / ``conformance_results`` (failure pictures, records and the HTML report;
+  default ``conformance-results``), ``--conformance-keep-passing`` / ``conformance_keep_passing`` (keep the
+  pictures of passing image checks too), and ``--regen-golden`` (make the selected scenes' goldens anew
+  before checking them; never done without it).
 
 Loading this plugin is cheap: it imports pybullet, VTK and the sync only when a conformance check
 is collected, so it stays out of the way of unrelated test suites in the same environment.
@@ -47,6 +54,9 @@ def pytest_addoption(parser: pytest.Parser) -> None:
     group.addoption("--conformance-report", dest="conformance_report", metavar="PATH", default=None,
                     help="write each check's outcome, scene and worst error as JSON to PATH")
     parser.addini("conformance_report", "default for --conformance-report", default=None)
+    from conformance import image_options
+
+    image_options.add_options(group, parser)
 
 
 _TOLERANCE_OPTIONS = {
@@ -90,6 +100,10 @@ def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line("markers", "scene(name): the reference scene a conformance check runs on")
     config.addinivalue_line("markers", "sync: a check that runs the sync implementation under test (added automatically)")
     config.stash[_VERDICT_KEY] = defaultdict(lambda: defaultdict(list))
+    if not hasattr(config, "workerinput"):
+        from conformance import image_options
+
+        image_options.from_config(config).start_session()
 
 
 def pytest_unconfigure(config: pytest.Config) -> None:
@@ -107,9 +121,12 @@ def pytest_report_header(config: pytest.Config) -> list[str]:
             versions.append(f"{dist} {md.version(dist)}")
         except md.PackageNotFoundError:
             versions.append(f"{dist} missing")
+    from conformance import image_options
+
     return [
         f"conformance: sync {_sync_spec(config)!r}; {profiles.describe()}; tolerance {tolerance_from(config).describe()}",
         "conformance: " + ", ".join(versions),
+        "conformance: " + image_options.from_config(config).describe(),
     ]
 
 
@@ -141,6 +158,14 @@ def sync_implementation(request: pytest.FixtureRequest):
         implementation = load(_sync_spec(request.config))
         request.config.stash[_SYNC_KEY] = implementation
         return implementation
+
+
+@pytest.fixture(scope="session")
+def pictures(request: pytest.FixtureRequest):
+    """Where goldens are read and failure pictures written, and the image tolerance in force."""
+    from conformance import image_options
+
+    return image_options.from_config(request.config)
 
 
 @pytest.fixture
@@ -176,6 +201,10 @@ def pytest_runtest_makereport(item: pytest.Item, call):
 
 
 def pytest_sessionfinish(session: pytest.Session, exitstatus) -> None:
+    if not hasattr(session.config, "workerinput"):  # under xdist, only the controller writes the page
+        from conformance import image_options
+
+        image_options.from_config(session.config).write_report(_sync_spec(session.config))
     path = _option(session.config, "report")
     if not path:
         return
@@ -191,6 +220,9 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus) -> None:
 
 
 def pytest_terminal_summary(terminalreporter, exitstatus, config: pytest.Config) -> None:
+    from conformance import image_options
+
+    image_options.from_config(config).summarize(terminalreporter)
     verdicts = config.stash.get(_VERDICT_KEY, None)
     if not verdicts:
         return

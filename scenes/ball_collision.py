@@ -46,7 +46,7 @@ SPEC = SceneSpec(
     name="ball_collision",
     title="Ball collision",
     populate=populate,
-    camera=Camera((0.30, -18.78, 0.89), (0.15, 0.25, 0.40), (0.0, 0.0, 1.0)),
+    camera=Camera((0.31, -39.89, 1.03), (0.0, 0.0, 0.0), (0.0, 0.0, 1.0), view_angle=30.0, clipping_range=(0.5, 45.0)),
     steps=51,
     origin="guide",
     poster_step=31,

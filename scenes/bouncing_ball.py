@@ -41,7 +41,7 @@ SPEC = SceneSpec(
     name="bouncing_ball",
     title="Bouncing ball",
     populate=populate,
-    camera=Camera((0.0, -3.6, 1.9), (0.0, 0.0, 0.45), (0.0, 0.0, 1.0)),
+    camera=Camera((0.0, -3.6, 1.9), (0.0, 0.0, 0.45), (0.0, 0.0, 1.0), view_angle=30.0, clipping_range=(0.5, 7.0)),
     # 2 s: the drop and four impacts at the defaults (about 0.45, 1.09, 1.55 and 1.89 s).
     steps=480,
     origin="canonical",

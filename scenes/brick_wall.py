@@ -77,8 +77,11 @@ SPEC = SceneSpec(
     name="brick_wall",
     title="Brick wall",
     populate=populate,
-    camera=Camera((10.46, -8.13, 6.18), (0.0, 0.0, 0.79), (-0.27, 0.26, 0.90)),
+    camera=Camera((10.46, -8.13, 6.18), (0.0, 0.0, 0.79), (-0.27, 0.26, 0.9), view_angle=30.0, clipping_range=(0.5, 20.0)),
     steps=131,
+    # Measured with conformance.state.first_divergence: a 1 nm nudge of every body exceeds the physics
+    # verdict's tolerance after step 2 (bricks resting on bricks).
+    chaotic_after=2,
     origin="guide",
     description="A 3 kg ball pushed once with 10 kN flies into a 10 × 10 brick wall; every body is its own actor.",
     parameters=parameters,

@@ -31,6 +31,7 @@ SPEC = SceneSpec(
     populate=populate,
     camera=brick_wall.SPEC.camera,
     steps=brick_wall.SPEC.steps,
+    chaotic_after=brick_wall.SPEC.chaotic_after,
     origin="guide",
     description="The brick wall scene with all bricks drawn by one shared box actor (vertex sync).",
     parameters=brick_wall.parameters,

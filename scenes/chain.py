@@ -110,7 +110,7 @@ SPEC = SceneSpec(
     name="chain",
     title="Chain",
     populate=populate,
-    camera=Camera((2.2, -3.0, 3.0), (-0.3, 0.6, 0.7), (-0.2, 0.2, 1.0)),
+    camera=Camera((3.9, -4.93, 4.17), (0.47, 0.0, 1.02), (-0.2, 0.2, 1.0), view_angle=30.0, clipping_range=(0.5, 9.0)),
     steps=131,
     origin="guide",
     description="A 20-link chain of spherical joints hangs from a pivot at z = 2 that swings along x.",

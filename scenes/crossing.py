@@ -148,7 +148,7 @@ SPEC = SceneSpec(
     name="crossing",
     title="Crossing",
     populate=populate,
-    camera=Camera((0.0, -3.2, 1.6), (0.0, 0.0, 1.0), (0.0, 0.0, 1.0)),
+    camera=Camera((-0.69, -4.95, 1.93), (-0.69, 0.0, 1.0), (0.0, 0.0, 1.0), view_angle=30.0, clipping_range=(0.5, 6.0)),
     steps=STEPS,
     origin="canonical",
     poster_step=60,

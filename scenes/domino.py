@@ -61,7 +61,7 @@ SPEC = SceneSpec(
     name="domino",
     title="Domino",
     populate=populate,
-    camera=Camera((10.46, -8.13, 6.18), (0.0, 0.0, 0.79), (-0.27, 0.26, 0.90)),
+    camera=Camera((10.46, -8.13, 6.18), (0.0, 0.0, 0.79), (-0.27, 0.26, 0.9), view_angle=30.0, clipping_range=(0.5, 31.0)),
     steps=301,
     origin="guide",
     description="Ten 2 m dominoes 0.99 m apart; the first is pushed once near its top and the row topples.",

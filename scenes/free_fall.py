@@ -34,7 +34,7 @@ SPEC = SceneSpec(
     name="free_fall",
     title="Free fall",
     populate=populate,
-    camera=Camera((4.0, -6.0, 2.5), (0.0, 0.0, 2.0), (0.0, 0.0, 1.0)),
+    camera=Camera((4.0, -6.0, 2.5), (0.0, 0.0, 2.0), (0.0, 0.0, 1.0), view_angle=30.0, clipping_range=(0.5, 9.0)),
     steps=120,
     origin="canonical",
     description="One spinning body falls from rest under g = -10 with damping switched off.",

@@ -100,7 +100,7 @@ SPEC = SceneSpec(
     name="pendulum",
     title="Pendulum",
     populate=populate,
-    camera=Camera((0.0, -5.0, 1.15), (0.0, 0.0, 1.15), (0.0, 0.0, 1.0)),
+    camera=Camera((0.0, -5.0, 1.15), (0.0, 0.0, 1.15), (0.0, 0.0, 1.0), view_angle=30.0, clipping_range=(0.5, 6.0)),
     # 2 s: about one period at the defaults (2π√(I/mgL) = 2.00 s, +2 % for the 0.6 rad amplitude).
     steps=480,
     origin="canonical",

@@ -56,7 +56,7 @@ SPEC = SceneSpec(
     name="sliding_box",
     title="Sliding box",
     populate=populate,
-    camera=Camera((-0.45, -4.0, 2.2), (-0.45, 0.0, 0.0), (0.0, 0.0, 1.0)),
+    camera=Camera((-0.45, -4.0, 2.2), (-0.45, 0.0, 0.0), (0.0, 0.0, 1.0), view_angle=30.0, clipping_range=(0.5, 7.0)),
     steps=360,
     origin="canonical",
     description="A flat box launched at 3 m/s along +x slides on a static plate until friction stops it.",

@@ -53,7 +53,7 @@ SPEC = SceneSpec(
     name="tumbling",
     title="Tumbling bodies",
     populate=populate,
-    camera=Camera((0.0, -6.0, 2.5), (0.0, 0.0, 1.2), (0.0, 0.0, 1.0)),
+    camera=Camera((-0.9, -34.2, 8.4), (-0.9, 0.86, 0.81), (0.0, 0.0, 1.0), view_angle=30.0, clipping_range=(0.5, 40.0)),
     steps=10_000,
     origin="canonical",
     description="Bodies spin near their unstable intermediate axis in zero gravity for 10,000 steps.",

@@ -63,7 +63,7 @@ SPEC = SceneSpec(
     name="weighted",
     title="Loaded bodies",
     populate=populate,
-    camera=Camera((0.0, -6.8, 3.4), (0.0, 0.0, 0.2), (0.0, 0.0, 1.0)),
+    camera=Camera((-0.11, -9.09, 5.06), (-0.11, 0.04, 0.77), (0.0, 0.0, 1.0), view_angle=30.0, clipping_range=(0.5, 14.0)),
     steps=480,
     origin="canonical",
     description="Six spinning bodies whose centre of mass is off their centre fall onto a plate and rock.",

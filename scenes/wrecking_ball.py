@@ -102,10 +102,13 @@ SPEC = SceneSpec(
     name="wrecking_ball",
     title="Wrecking ball",
     populate=populate,
-    camera=Camera((10.28, -7.10, 6.39), (0.0, 0.0, 0.4), (-0.35, 0.26, 1.0)),
+    camera=Camera((10.28, -7.1, 6.39), (0.0, 0.0, 0.4), (-0.35, 0.26, 1.0), view_angle=30.0, clipping_range=(0.5, 19.0)),
     steps=131,
     origin="guide",
     poster_step=45,
+    # Measured with conformance.state.first_divergence: a 1 nm nudge of every body exceeds the physics
+    # verdict's tolerance after step 1 (bricks resting on bricks; the ball's whip later).
+    chaotic_after=1,
     description="A 5 kg ball on a 15-link chain pinned at z = 2, its hinge pushed once, smashes a 5×5×5 brick block.",
     parameters=parameters,
 )

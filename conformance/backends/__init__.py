@@ -8,6 +8,8 @@ The rest of the kit talks to a backend only through these functions:
 * ``mesh_signature(actor)``: vertex count, topology and colours, to check a sync keeps the mesh;
 * ``content_state(actor)``: modification time and data digest, to check changes are announced;
 * ``render(drawing, camera, size, *, multisamples) -> (h, w, 3) uint8``: an off-screen picture;
+* ``render_ids(drawing, camera, size) -> (h, w) int32``: each pixel's target index (-1 background),
+  every target drawn flat in its own colour (the silhouette check against pyBullet's renderer);
 * ``renderer_info() -> dict``: what draws the pictures (OpenGL vendor/renderer/version, VTK version).
 
 FURY 0.12 (VTK) is the only backend today; FURY 2.x (pygfx) would be a sibling module.
@@ -15,6 +17,6 @@ FURY 0.12 (VTK) is the only backend today; FURY 2.x (pygfx) would be a sibling m
 
 from __future__ import annotations
 
-from .vtk import Drawing, build, content_state, mesh_signature, render, renderer_info, world_normals, world_vertices
+from .vtk import Drawing, build, content_state, mesh_signature, render, render_ids, renderer_info, world_normals, world_vertices
 
-__all__ = ["Drawing", "build", "content_state", "mesh_signature", "render", "renderer_info", "world_normals", "world_vertices"]
+__all__ = ["Drawing", "build", "content_state", "mesh_signature", "render", "render_ids", "renderer_info", "world_normals", "world_vertices"]

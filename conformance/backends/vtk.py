@@ -20,7 +20,7 @@ from conformance.display import close_x_connection, ensure_display, on_stop, x_c
 from conformance.errors import SceneError
 from conformance.world import Target, World
 
-__all__ = ["Drawing", "build", "content_state", "mesh_signature", "render", "renderer_info", "world_normals", "world_vertices"]
+__all__ = ["Drawing", "build", "content_state", "mesh_signature", "render", "render_ids", "renderer_info", "world_normals", "world_vertices"]
 
 IDENTITY_POSITION = np.zeros(3)
 IDENTITY_ORIENTATION = np.array([0.0, 0.0, 0.0, 1.0])
@@ -241,10 +241,7 @@ def render(drawing: Drawing, camera, size: tuple[int, int], *, background=(1.0, 
     stage.background(background)
     for actor in drawing.actors.values():
         stage.add(actor)
-    stage.set_camera(position=camera.position, focal_point=camera.focal_point, view_up=camera.view_up)
-    vtk_camera = stage.GetActiveCamera()
-    vtk_camera.SetViewAngle(camera.view_angle)
-    vtk_camera.SetClippingRange(*camera.clipping_range)
+    _set_camera(stage, camera)
     render_window = _render_window()
     render_window.SetMultiSamples(multisamples)
     render_window.AddRenderer(stage)
@@ -255,6 +252,16 @@ def render(drawing: Drawing, camera, size: tuple[int, int], *, background=(1.0, 
     finally:
         render_window.RemoveRenderer(stage)
         stage.clear()
+
+
+def _set_camera(stage, camera) -> None:
+    """Apply ``camera`` whole to ``stage``: the one camera code path of :func:`render` and
+    :func:`render_ids`. The clipping range is set after FURY's ``set_camera``, which resets it to the
+    scene's bounds; the view angle is vertical (VTK's default)."""
+    stage.set_camera(position=camera.position, focal_point=camera.focal_point, view_up=camera.view_up)
+    vtk_camera = stage.GetActiveCamera()
+    vtk_camera.SetViewAngle(camera.view_angle)
+    vtk_camera.SetClippingRange(*camera.clipping_range)
 
 
 def renderer_info() -> dict[str, str]:
@@ -273,3 +280,105 @@ def renderer_info() -> dict[str, str]:
             if key.strip() == f"OpenGL {name} string":
                 info[f"gl_{name}"] = value.strip()
     return info
+
+
+# -- the flat ID render (the silhouette check) ------------------------------------------------------
+
+def id_colors(count: int) -> np.ndarray:
+    """The ``(count, 3)`` uint8 colour of each target index in :func:`render_ids`: ``index + 1`` times a
+    stride spreading the codes over the 24-bit colour cube (black, code 0, is the background), so that
+    no two are neighbours and a blended pixel is almost never another target's colour."""
+    stride = max(1, (2**24 - 1) // (count + 1))
+    values = (np.arange(count, dtype=np.int64) + 1) * stride
+    return np.stack([(values >> 16) & 255, (values >> 8) & 255, values & 255], axis=1).astype(np.uint8)
+
+
+def decode_ids(picture: np.ndarray, count: int) -> np.ndarray:
+    """``(h, w)`` int32 target index of each pixel of an ID ``picture`` (-1 for the background).
+
+    Raises ``RuntimeError`` if any pixel is neither the background nor exactly a target's colour:
+    the renderer blended (anti-aliasing, lighting, translucency), and the picture cannot be trusted."""
+    stride = max(1, (2**24 - 1) // (count + 1))
+    values = (picture[..., 0].astype(np.int64) << 16) | (picture[..., 1].astype(np.int64) << 8) | picture[..., 2]
+    index, remainder = np.divmod(values, stride)
+    bad = (remainder != 0) | (index > count)
+    if bad.any():
+        raise RuntimeError(f"ID render: {int(bad.sum())} pixels are not exactly a target's colour (blended?)")
+    return (index - 1).astype(np.int32)
+
+
+def render_ids(drawing: Drawing, camera, size: tuple[int, int]) -> np.ndarray:
+    """``(height, width)`` int32: the index into ``drawing.targets`` of the target seen at each pixel,
+    -1 for the background; top row first, like :func:`render`.
+
+    Each target is drawn in its own flat colour (point scalars; targets sharing an actor get their own
+    vertex range ``start:stop`` coloured), unlit (lighting off, ambient 1, diffuse 0, specular 0,
+    opacity 1), without anti-aliasing, through :func:`render` itself, so the camera is applied by the
+    same code. Only the colour is replaced: vertices, user matrix, position, orientation, scale,
+    visibility and everything else a sync left on an actor is drawn as it is. Afterwards each actor
+    has its own property object, mapper colour settings and colour bytes back, byte for byte.
+
+    Writing the colours and writing them back bumps the modification time of the point data, so VTK
+    re-uploads each actor's geometry for this picture and for the next one: a sync that changed vertices
+    without ``Modified()`` would be drawn right here and in any picture after it. That is acceptable
+    because the golden check renders first in each frame and catches such a sync; the vertex checks'
+    ``content_state`` compares times around the sync call only, which this does not straddle.
+    """
+    from vtkmodules.vtkRenderingCore import vtkProperty
+
+    colors = id_colors(len(drawing.targets))
+    by_actor: dict[int, list[int]] = defaultdict(list)
+    actors = {}
+    for i, target in enumerate(drawing.targets):
+        by_actor[id(target.actor)].append(i)
+        actors[id(target.actor)] = target.actor
+    restore = []
+    render_window = _render_window()
+    multisamples = render_window.GetMultiSamples()
+    try:
+        for key, actor in actors.items():
+            mapper, data = actor.GetMapper(), actor.GetMapper().GetInput()
+            scalars = data.GetPointData().GetScalars()
+            saved = (actor, actor.GetProperty(), mapper.GetScalarVisibility(), mapper.GetColorMode(),
+                     mapper.GetScalarMode(), scalars)
+            codes = np.zeros((data.GetNumberOfPoints(), 3), dtype=np.uint8)
+            for i in by_actor[key]:
+                codes[drawing.targets[i].start:drawing.targets[i].stop] = colors[i]
+            if scalars is not None and scalars.GetDataTypeAsString() == "unsigned char" \
+                    and scalars.GetNumberOfComponents() in (3, 4):
+                # Written in place, so the array object, its name and its place in the point data stay.
+                view = numpy_support.vtk_to_numpy(scalars).reshape(len(codes), -1)
+                restore.append(saved + (view.copy(),))
+                view[:, :3] = codes
+                if view.shape[1] == 4:
+                    view[:, 3] = 255
+                scalars.Modified()
+            else:
+                restore.append(saved + (None,))
+                data.GetPointData().SetScalars(numpy_support.numpy_to_vtk(codes, deep=True))
+            flat = vtkProperty()
+            flat.DeepCopy(actor.GetProperty())  # culling, representation, … as the actor has them
+            flat.LightingOff()
+            flat.SetAmbient(1.0)
+            flat.SetDiffuse(0.0)
+            flat.SetSpecular(0.0)
+            flat.SetOpacity(1.0)
+            actor.SetProperty(flat)
+            mapper.ScalarVisibilityOn()
+            mapper.SetColorModeToDirectScalars()
+            mapper.SetScalarModeToUsePointData()
+        picture = render(drawing, camera, size, background=(0.0, 0.0, 0.0), multisamples=0)
+    finally:
+        render_window.SetMultiSamples(multisamples)
+        for actor, prop, visibility, color_mode, scalar_mode, scalars, bytes_ in reversed(restore):
+            mapper, data = actor.GetMapper(), actor.GetMapper().GetInput()
+            if bytes_ is not None:
+                numpy_support.vtk_to_numpy(scalars).reshape(len(bytes_), -1)[:] = bytes_
+                scalars.Modified()
+            else:
+                data.GetPointData().SetScalars(scalars)
+            actor.SetProperty(prop)
+            mapper.SetScalarVisibility(visibility)
+            mapper.SetColorMode(color_mode)
+            mapper.SetScalarMode(scalar_mode)
+    return decode_ids(picture, len(drawing.targets))

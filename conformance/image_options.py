@@ -1,0 +1,156 @@
+"""The image checks' options, validated in one place, and what the checks need from them.
+
+Each option has an ini twin (command line first): ``--conformance-golden-dir``, ``--conformance-image-tolerance``,
+``--conformance-results``, ``--conformance-keep-passing``, and ``--regen-golden``. :func:`from_config`
+reads them once per session and refuses bad values with a ``pytest.UsageError`` that names the
+option, the value and what it should be.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+__all__ = ["Pictures", "add_options", "from_config"]
+
+TOLERANCE_CHOICES = ("auto", "same-renderer", "other-renderer")
+DEFAULT_RESULTS = "conformance-results"
+_KEY = pytest.StashKey["Pictures"]()
+_REGENERATED = "conformance_golden_regenerated"
+
+
+def add_options(group, parser) -> None:
+    group.addoption("--conformance-golden-dir", dest="conformance_golden_dir", metavar="DIR", default=None,
+                    help="directory of golden snapshots (default: the kit's own)")
+    parser.addini("conformance_golden_dir", "default for --conformance-golden-dir", default=None)
+    group.addoption("--conformance-image-tolerance", dest="conformance_image_tolerance", metavar="SET", default=None,
+                    help="image tolerance set: auto (same-renderer when a golden's manifest names this machine's "
+                    "renderer, else other-renderer), same-renderer or other-renderer. Default auto")
+    parser.addini("conformance_image_tolerance", "default for --conformance-image-tolerance", default=None)
+    group.addoption("--conformance-results", dest="conformance_results", metavar="DIR", default=None,
+                    help=f"where failure pictures, image-check records and report.html go (default {DEFAULT_RESULTS})")
+    parser.addini("conformance_results", "default for --conformance-results", default=None)
+    group.addoption("--conformance-keep-passing", dest="conformance_keep_passing", action="store_true", default=None,
+                    help="keep the pictures of passing image checks too (the report then shows them)")
+    parser.addini("conformance_keep_passing", "default for --conformance-keep-passing", type="bool", default=False)
+    group.addoption("--regen-golden", dest="conformance_regen_golden", action="store_true", default=False,
+                    help="make the goldens of the selected scenes anew (reference sync) before checking them; "
+                    "prints what changed. Goldens are never written without this")
+
+
+def _value(config, name: str):
+    value = config.getoption(f"conformance_{name}")
+    return value if value is not None else config.getini(f"conformance_{name}")
+
+
+@dataclass
+class Pictures:
+    """What the image checks need from the session: where goldens are, which tolerance set, where
+    to put pictures, whether to regenerate."""
+
+    golden_dir: Path
+    tolerance: str  # one of TOLERANCE_CHOICES
+    results: Path
+    keep_passing: bool
+    regen: bool
+    _renderer: dict[str, str] | None = field(default=None, repr=False)
+    kept: int = 0
+
+    # -- the checks' side ---------------------------------------------------------------------
+    @property
+    def renderer(self) -> dict[str, str]:
+        if self._renderer is None:
+            from conformance import backends
+
+            self._renderer = backends.renderer_info()
+        return self._renderer
+
+    def tolerance_for(self, golden):
+        from conformance.rendering import snapshots
+
+        return snapshots.tolerance_for(golden, self.renderer, None if self.tolerance == "auto" else self.tolerance)
+
+    def keep(self, record, images: dict[str, Any]) -> None:
+        """Write a check's pictures (failures always; passes when asked) and its record."""
+        from conformance.rendering import artefacts
+
+        artefacts.write_artefacts(record, self.results, images if (not record.passed or self.keep_passing) else {})
+        self.kept += 1
+
+    def note_regenerated(self, node, changes) -> None:
+        for change in changes:
+            node.user_properties.append((_REGENERATED, change.describe()))
+
+    # -- the session's side -------------------------------------------------------------------
+    def describe(self) -> str:
+        where = "the kit's own" if self.golden_dir == _default_golden_dir() else str(self.golden_dir)
+        tolerance = ("auto (same-renderer for goldens this machine's renderer made, else other-renderer)"
+                     if self.tolerance == "auto" else self.tolerance)
+        return (f"goldens: {where}; image tolerance {tolerance}; results in {self.results}"
+                + ("; REGENERATING goldens" if self.regen else ""))
+
+    def start_session(self) -> None:
+        """Forget the pictures and records of an earlier run (only what the kit writes there), so
+        the report shows this run alone. Called once, by the controller, before any check runs."""
+        from conformance.rendering import artefacts
+
+        artefacts.clear(self.results)
+        (self.results / "report.html").unlink(missing_ok=True)
+
+    def write_report(self, sync: str):
+        from conformance.rendering import artefacts, report
+
+        if not self.results.is_dir():
+            return None
+        records = artefacts.read_records(self.results)
+        if not records:
+            return None
+        header = [f"sync under test: {sync}", self.describe()]
+        self.report_path = report.write_report(records, self.results, title="FURY–pyBullet image checks",
+                                               header_lines=header)
+        return self.report_path
+
+    def summarize(self, terminalreporter) -> None:
+        regenerated = [value for report in terminalreporter.stats.get("passed", []) + terminalreporter.stats.get("failed", [])
+                       for key, value in getattr(report, "user_properties", ()) if key == _REGENERATED]
+        if regenerated:
+            terminalreporter.section("goldens regenerated")
+            for line in regenerated:
+                terminalreporter.write_line(line)
+        path = getattr(self, "report_path", None)
+        if path is not None:
+            terminalreporter.write_line(f"conformance: image checks report: {path}")
+
+
+def _default_golden_dir() -> Path:
+    from conformance.rendering import golden
+
+    return golden.default_dir()
+
+
+def from_config(config) -> Pictures:
+    """The session's :class:`Pictures`, read and validated once."""
+    cached = config.stash.get(_KEY, None)
+    if cached is not None:
+        return cached
+    tolerance = _value(config, "image_tolerance") or "auto"
+    if tolerance not in TOLERANCE_CHOICES:
+        raise pytest.UsageError(f"conformance_image_tolerance={tolerance!r} ({type(tolerance).__name__}), "
+                                f"but should be one of {', '.join(TOLERANCE_CHOICES)}")
+    golden_dir = _value(config, "golden_dir")
+    golden_dir = Path(golden_dir).expanduser().resolve() if golden_dir else _default_golden_dir()
+    if not golden_dir.is_dir() and not config.getoption("conformance_regen_golden"):
+        raise pytest.UsageError(f"conformance_golden_dir={str(golden_dir)!r} is not a directory; give an existing "
+                                "directory of goldens, or add --regen-golden to make them there")
+    results = Path(_value(config, "results") or DEFAULT_RESULTS).expanduser()
+    if results.exists() and not results.is_dir():
+        raise pytest.UsageError(f"conformance_results={str(results)!r} is a file, but should be a directory "
+                                "(it receives failure pictures and report.html)")
+    keep = _value(config, "keep_passing")
+    pictures = Pictures(golden_dir=golden_dir, tolerance=tolerance, results=results.resolve(),
+                        keep_passing=bool(keep), regen=bool(config.getoption("conformance_regen_golden")))
+    config.stash[_KEY] = pictures
+    return pictures

@@ -1,0 +1,206 @@
+"""Golden snapshots on disk: a PNG and a JSON manifest per scene frame; reading, validating, writing.
+
+Layout: ``<golden dir>/<scene>/frame-<NNNN>.png`` and ``frame-<NNNN>.json`` beside it. The manifest
+says how the picture was made (scene, parameters, frame, camera, size, sync, the renderer's OpenGL
+strings, library versions) and holds the physics state of that frame (:mod:`conformance.state`).
+
+Guarantees:
+
+* reading validates everything before anything is compared, and a golden that cannot be used raises
+  one :class:`~conformance.errors.GoldenError` paragraph naming the file, what is wrong and the
+  command that makes it anew (:func:`regen_command`): a missing PNG or manifest, a file that is not a
+  PNG or is truncated, a picture of the wrong size, a malformed manifest, or one made for other
+  parameters, another frame or another camera;
+* writing is atomic (a temporary file in the same directory, then a rename): a golden is never
+  half-written, and concurrent writers (pytest-xdist workers) never see one;
+* the bytes depend only on the pixels and the manifest's content: PNGs carry no time or software
+  chunks and manifests are JSON with sorted keys, so regenerating an unchanged golden changes no byte.
+"""
+
+from __future__ import annotations
+
+import importlib.metadata as md
+import io
+import json
+import os
+import shlex
+import tempfile
+import zlib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from conformance.errors import GoldenMissing, GoldenUnreadable
+
+__all__ = ["FORMAT", "Golden", "default_dir", "library_versions", "paths", "read", "regen_command",
+           "write", "encode_png"]
+
+#: The manifest format; bumped when its meaning changes, so an old manifest is refused, not misread.
+FORMAT = 1
+_REQUIRED = ("format", "scene", "params", "frame", "camera", "size", "sync", "renderer", "versions", "state")
+
+
+def default_dir() -> Path:
+    """The goldens shipped with the kit (``golden/`` in a checkout, ``conformance/golden`` in a wheel)."""
+    return Path(__file__).resolve().parent.parent / "golden"
+
+
+def paths(directory: Path | str, scene: str, frame: int) -> tuple[Path, Path]:
+    """The PNG and manifest paths of ``scene`` at ``frame``."""
+    base = Path(directory) / scene / f"frame-{frame:04d}"
+    return base.with_suffix(".png"), base.with_suffix(".json")
+
+
+def regen_command(scene: str, *, frame: int | None = None) -> str:
+    """The command that (re)makes a scene's goldens."""
+    del frame  # every golden frame of a scene is made together: they share one run
+    return shlex.join(["python", "-m", "conformance", "regen", scene])
+
+
+def library_versions() -> dict[str, str]:
+    versions = {}
+    for dist in ("vtk", "fury", "pybullet", "numpy"):
+        try:
+            versions[dist] = md.version(dist)
+        except md.PackageNotFoundError:
+            versions[dist] = "missing"
+    return versions
+
+
+def _jsonable(value: Any) -> Any:
+    """Parameters as JSON holds them (tuples become lists), for storing and comparing alike."""
+    return json.loads(json.dumps(value))
+
+
+@dataclass(frozen=True)
+class Golden:
+    """A golden picture, ``(height, width, 3)`` uint8, and its manifest."""
+
+    image: np.ndarray
+    manifest: dict[str, Any]
+    png: Path
+
+    @property
+    def state(self) -> dict[str, Any]:
+        return self.manifest["state"]
+
+    @property
+    def renderer(self) -> dict[str, str]:
+        return self.manifest["renderer"]
+
+
+def _unreadable(path: Path, scene: str, problem: str) -> GoldenUnreadable:
+    return GoldenUnreadable(f"golden {str(path)!r} of scene {scene!r} {problem}; nothing was compared and nothing "
+                            f"was written. If the scene changed on purpose, make its goldens anew: "
+                            f"{regen_command(scene)}")
+
+
+def _decode_png(path: Path, scene: str) -> np.ndarray:
+    from PIL import Image, UnidentifiedImageError
+
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise _unreadable(path, scene, f"cannot be read ({exc.strerror})") from None
+    try:
+        with Image.open(io.BytesIO(data)) as picture:
+            if picture.format != "PNG":
+                raise _unreadable(path, scene, f"is a {picture.format} file, not a PNG")
+            picture.load()  # decodes every row: a truncated file fails here, not later
+            return np.asarray(picture.convert("RGB"))
+    except UnidentifiedImageError:
+        raise _unreadable(path, scene, f"is not a PNG (its first bytes are {data[:8]!r})") from None
+    except (OSError, SyntaxError, ValueError, zlib.error) as exc:
+        raise _unreadable(path, scene, f"is damaged or truncated ({exc})") from None
+
+
+def read(directory: Path | str, scene: str, frame: int, *, params: dict[str, Any], camera: dict[str, Any],
+         size: tuple[int, int]) -> Golden:
+    """The golden of ``scene`` at ``frame``, validated against what the check is about to render."""
+    png, manifest_path = paths(directory, scene, frame)
+    if not png.exists() or not manifest_path.exists():
+        missing = " and ".join(str(p) for p in (png, manifest_path) if not p.exists())
+        raise GoldenMissing(f"no golden for scene {scene!r} at frame {frame}: {missing} does not exist. "
+                            f"Make it with: {regen_command(scene)} (then look at the picture before you commit it)")
+    try:
+        manifest = json.loads(manifest_path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise _unreadable(manifest_path, scene, f"has a manifest that is not valid JSON ({exc})") from None
+    if not isinstance(manifest, dict) or any(key not in manifest for key in _REQUIRED):
+        absent = [k for k in _REQUIRED if not isinstance(manifest, dict) or k not in manifest]
+        raise _unreadable(manifest_path, scene, f"has a manifest without {', '.join(absent)}")
+    if manifest["format"] != FORMAT:
+        raise _unreadable(manifest_path, scene, f"has manifest format {manifest['format']!r}, but this kit reads format {FORMAT}")
+    expected = {"scene": scene, "frame": frame, "params": _jsonable(params), "camera": _jsonable(camera),
+                "size": list(size)}
+    for key, value in expected.items():
+        if manifest[key] != value:
+            raise _unreadable(manifest_path, scene, f"was made for {key} {manifest[key]!r}, but the check renders "
+                                                     f"{key} {value!r}")
+    image = _decode_png(png, scene)
+    if image.shape[:2] != (size[1], size[0]):
+        raise _unreadable(png, scene, f"is {image.shape[1]}x{image.shape[0]} pixels, but the scene renders "
+                                      f"{size[0]}x{size[1]}")
+    return Golden(image=image, manifest=manifest, png=png)
+
+
+def encode_png(image: np.ndarray) -> bytes:
+    """PNG bytes that depend only on the pixels: no time, text or software chunks."""
+    from PIL import Image
+
+    buffer = io.BytesIO()
+    Image.fromarray(np.ascontiguousarray(image, dtype=np.uint8)).save(buffer, format="PNG", optimize=True)
+    return buffer.getvalue()
+
+
+def encode_manifest(manifest: dict[str, Any]) -> bytes:
+    """Sorted keys, one line per setting, and one line per body and per target in the state: readable
+    in a diff, and small (a state of a hundred bodies is tens of kilobytes)."""
+    data = _jsonable(manifest)
+    state = data.pop("state", None)
+    text = json.dumps(data, indent=1, sort_keys=True)
+    if state is not None:
+        compact = {"separators": (",", ":"), "sort_keys": True}
+        parts = []
+        for key in sorted(state):
+            rows = ",\n  ".join(json.dumps(row, **compact) for row in state[key])
+            parts.append(f' "{key}": [\n  {rows}\n ]')
+        text = text[:-2] + ',\n "state": {\n' + ",\n".join(parts) + "\n }\n}"
+    return (text + "\n").encode("utf-8")
+
+
+def _write_atomically(path: Path, data: bytes) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        os.fchmod(fd, 0o666 & ~_umask())  # mkstemp makes 0600; a golden is an ordinary file of the checkout
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+def write(directory: Path | str, scene: str, frame: int, image: np.ndarray, manifest: dict[str, Any]) -> bool:
+    """Write a golden and its manifest atomically; return whether any byte changed. Unchanged files
+    are not touched. The manifest is written last, so a reader never pairs a new manifest with an
+    old picture for longer than the two renames."""
+    png, manifest_path = paths(directory, scene, frame)
+    changed = False
+    for path, data in ((png, encode_png(image)), (manifest_path, encode_manifest(manifest))):
+        if path.exists() and path.read_bytes() == data:
+            continue
+        _write_atomically(path, data)
+        changed = True
+    return changed

@@ -1,0 +1,163 @@
+"""Each target's FURY silhouette against pyBullet's own renderer: the render check that needs no golden.
+
+pyBullet draws its bodies itself: ``getCameraImage(width, height, viewMatrix, projectionMatrix,
+renderer=ER_TINY_RENDERER, flags=ER_SEGMENTATION_MASK_OBJECT_AND_LINKINDEX)`` (pyBullet Quickstart
+Guide, "getCameraImage") returns a segmentation mask whose value at a pixel is
+``objectUniqueId + ((linkIndex + 1) << 24)`` of the body seen there, -1 for none. The camera is the
+scene's own, as 16-float column-major matrices from :mod:`.projection` (the Quickstart's
+``computeViewMatrix`` and ``computeProjectionMatrixFOV`` give the same numbers, to float32).
+FURY's side is :func:`conformance.backends.render_ids`: every target flat in its own colour.
+
+Measured facts this relies on (pybullet 3.2.7, DIRECT mode; proved in ``tests/test_silhouettes.py``):
+
+* the tiny renderer draws bodies created with collision shapes only (no visual shape): boxes,
+  spheres and cylinders are all drawn, from the collision shape;
+* row 0 of the mask is the top of the picture, as in VTK's (flipped) snapshot;
+* the tiny renderer samples pixel corners, not centres: its picture is offset by half a pixel (+0.5 px
+  right, -0.5 px up, measured on every box of ``mixed_shapes``); :data:`HALF_PIXEL` shifts its
+  projection by half a pixel to undo that, after which a single box agrees pixel for pixel.
+
+Thresholds, measured with the reference sync at every scene's golden frames (IoU with a 1 px edge
+slack, worst target of each kind over the scene's three frames): boxes 0.994 (wrecking_ball, a brick
+partly hidden by the ball), 1.000 elsewhere; spheres 0.987 (crossing), 0.991 (wrecking_ball), 1.000
+elsewhere (pyBullet's coarser sphere is within 1 px of FURY's); cylinders 0.722 (chain: 1 m discs seen
+as slivers of rim, 16-gon against pyBullet's tessellation), 0.812 (mixed_shapes: the tiny renderer's
+depth test where a cylinder stands on the ground), 0.867 (wrecking_ball links). Hence ``MIN_IOU``:
+0.98 for boxes and spheres, 0.7 for cylinders (weak: a cylinder is judged coarsely). Measured: a box
+moved by 2 px gives 0.969 (fails); a 3° turn of a 55 px box is NOT caught with the 1 px slack (plain
+IoU 0.96-0.97, slack IoU 1.0); a 10 % wrong view angle or a 3 cm shifted focal point fails.
+"""
+
+from __future__ import annotations
+
+from typing import Sequence
+
+import numpy as np
+import pybullet
+from scipy import ndimage
+
+from . import projection
+from .records import ImageCheck
+
+__all__ = ["MIN_IOU", "MIN_PIXELS", "SLACK", "compare_silhouettes", "mask_images", "pybullet_mask", "thresholds"]
+
+#: A target is judged only where it covers at least this many pixels in either mask: below that its
+#: IoU is dominated by which edge pixels each rasteriser keeps.
+MIN_PIXELS = 50
+
+#: The worst IoU (with :data:`SLACK`) a target may have, by shape kind. See the module docstring.
+MIN_IOU = {"box": 0.98, "sphere": 0.98, "cylinder": 0.7}
+
+HALF_PIXEL = True
+
+#: Pixels a silhouette's edge may be off before a mismatch counts (see :func:`compare_silhouettes`).
+SLACK = 1
+
+
+def pybullet_mask(scene, bindings: Sequence, camera, size) -> np.ndarray:
+    """``(height, width)`` int32: the index into ``bindings`` of the (body, link) pyBullet's tiny
+    renderer sees at each pixel, -1 for the background or a body no binding names; top row first."""
+    width, height = size
+    view = projection.view_matrix(camera).T.ravel().tolist()
+    matrix = projection.projection_matrix(camera, size)
+    if HALF_PIXEL:
+        matrix[0, 2] += 1.0 / width
+        matrix[1, 2] += 1.0 / height
+    proj = matrix.T.ravel().tolist()
+    image = scene.p.getCameraImage(width, height, viewMatrix=view, projectionMatrix=proj,
+                                   renderer=pybullet.ER_TINY_RENDERER,
+                                   flags=pybullet.ER_SEGMENTATION_MASK_OBJECT_AND_LINKINDEX)
+    seg = np.asarray(image[4], dtype=np.int64).reshape(height, width)
+    out = np.full(seg.shape, -1, dtype=np.int32)
+    for i, b in enumerate(bindings):
+        out[seg == b.body + ((b.link + 1) << 24)] = i
+    return out
+
+
+def _far_mismatch(a: np.ndarray, b: np.ndarray, slack: int) -> int:
+    """Pixels in exactly one of masks ``a`` and ``b`` that are more than ``slack`` pixels (chessboard
+    distance) from the other mask: what a different tessellation or rasterisation of the same edge
+    cannot explain."""
+    if slack <= 0:
+        return int(np.count_nonzero(a ^ b))
+    structure = np.ones((2 * slack + 1, 2 * slack + 1), dtype=bool)
+    near_a = ndimage.binary_dilation(a, structure)
+    near_b = ndimage.binary_dilation(b, structure)
+    return int(np.count_nonzero(a & ~near_b) + np.count_nonzero(b & ~near_a))
+
+
+def compare_silhouettes(ids_fury: np.ndarray, ids_pybullet: np.ndarray, *, min_pixels: int = MIN_PIXELS,
+                        min_iou=0.95, slack: int = SLACK, names: Sequence[str] = (), scene: str = "",
+                        frame: int = 0) -> ImageCheck:
+    """Per target, how well FURY's silhouette and pyBullet's agree, for every target covering at least
+    ``min_pixels`` pixels in either mask; passes when each such target's IoU is at least its ``min_iou``
+    (one number for every target, or a sequence indexed by target, e.g. :func:`thresholds`).
+
+    The IoU is taken with an edge slack: a pixel in one mask only counts against the target if it is
+    more than ``slack`` pixels from the other mask, so ``iou = 1 - far / union`` (``slack=0``: the plain
+    intersection over union, also reported per target as ``plain_iou``). ``names`` name the targets."""
+    if ids_fury.shape != ids_pybullet.shape:
+        raise ValueError(f"mask shapes differ: {ids_fury.shape} vs {ids_pybullet.shape}")
+    count = int(max(ids_fury.max(initial=-1), ids_pybullet.max(initial=-1), len(names) - 1)) + 1
+    fury = np.bincount(ids_fury.ravel() + 1, minlength=count + 1)[1:]
+    bullet = np.bincount(ids_pybullet.ravel() + 1, minlength=count + 1)[1:]
+    both = np.bincount(ids_fury[ids_fury == ids_pybullet].ravel() + 1, minlength=count + 1)[1:]
+    limits = [float(min_iou)] * count if np.ndim(min_iou) == 0 else [float(x) for x in min_iou]
+    targets = []
+    for i in np.flatnonzero(np.maximum(fury, bullet) >= min_pixels):
+        a, b = ids_fury == i, ids_pybullet == i
+        rows, cols = np.nonzero(a | b)  # work on the target's box, grown by the slack, not the whole picture
+        box = (slice(max(rows.min() - slack, 0), rows.max() + slack + 1),
+               slice(max(cols.min() - slack, 0), cols.max() + slack + 1))
+        union = int(fury[i] + bullet[i] - both[i])
+        targets.append({"target": names[i] if i < len(names) else f"#{i}", "index": int(i),
+                        "iou": 1.0 - _far_mismatch(a[box], b[box], slack) / union,
+                        "plain_iou": float(both[i] / union),
+                        "fury_pixels": int(fury[i]), "pybullet_pixels": int(bullet[i]), "min_iou": limits[i]})
+    # The worst target is the one furthest below (or least above) its own threshold.
+    worst = min(targets, key=lambda t: t["iou"] - t["min_iou"], default=None)
+    where = f"[{scene}, frame {frame}]"
+    details = {"targets": targets, "min_pixels": min_pixels, "slack": slack}
+    if worst is None:
+        return ImageCheck(kind="silhouette", scene=scene, frame=frame, passed=True, details=details,
+                          message=f"no target covers {min_pixels} pixels in either mask {where}")
+    passed = all(t["iou"] >= t["min_iou"] for t in targets)
+    min_iou = worst["min_iou"]
+    message = (f"silhouette of {worst['target']!r}: IoU with pyBullet's mask = {worst['iou']:.3f}"
+               f"{', but should be at least' if not passed else ' (at least'} {min_iou:.3f}{'' if not passed else ')'}"
+               f" ({worst['fury_pixels']} FURY pixels, {worst['pybullet_pixels']} pyBullet pixels, plain IoU "
+               f"{worst['plain_iou']:.3f}, edge slack {slack} px) {where}")
+    failing = [t["target"] for t in targets if t["iou"] < t["min_iou"]]
+    if len(failing) > 1:
+        message += f"; {len(failing)} targets below it: {', '.join(failing[:10])}"
+    return ImageCheck(kind="silhouette", scene=scene, frame=frame, passed=passed, message=message,
+                      metrics={"iou": worst["iou"]}, limits={"iou": float(min_iou)}, details=details)
+
+
+def thresholds(bindings: Sequence) -> list[float]:
+    """Each binding's ``min_iou``, by the kind of its shape (:data:`MIN_IOU`)."""
+    return [MIN_IOU[b.shape.kind] for b in bindings]
+
+
+def _palette(count: int) -> np.ndarray:
+    """A fixed colour per target index (black last, for -1): the same target, the same colour, in every picture."""
+    rng = np.random.default_rng(12345)
+    colors = rng.integers(60, 256, size=(count + 1, 3)).astype(np.uint8)
+    colors[-1] = 0
+    return colors
+
+
+def mask_images(ids_fury: np.ndarray, ids_pybullet: np.ndarray) -> dict[str, np.ndarray]:
+    """RGB uint8 pictures for a failure report: ``fury_mask`` and ``pybullet_mask`` (each target in its
+    own colour, the same in both; background black) and ``mask_difference`` (white where both agree on
+    a target, red where only FURY draws a target there, blue where only pyBullet does, yellow where
+    both draw different targets)."""
+    count = int(max(ids_fury.max(initial=-1), ids_pybullet.max(initial=-1))) + 1
+    palette = _palette(count)
+    difference = np.zeros(ids_fury.shape + (3,), dtype=np.uint8)
+    same = (ids_fury == ids_pybullet) & (ids_fury >= 0)
+    difference[same] = (255, 255, 255)
+    difference[(ids_fury >= 0) & (ids_pybullet < 0)] = (255, 0, 0)
+    difference[(ids_fury < 0) & (ids_pybullet >= 0)] = (0, 0, 255)
+    difference[(ids_fury >= 0) & (ids_pybullet >= 0) & ~same] = (255, 255, 0)
+    return {"fury_mask": palette[ids_fury], "pybullet_mask": palette[ids_pybullet], "mask_difference": difference}

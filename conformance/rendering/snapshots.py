@@ -1,0 +1,204 @@
+"""Golden snapshots of the reference scenes: making them, and the two verdicts on each.
+
+* :func:`make` runs a scene with the reference sync and renders it at its golden frames
+  (``SceneSpec.frames_with_goldens()``: the first, the middle of the action, the last), capturing the
+  physics state of each frame for the manifest;
+* :func:`check_render` (the *render* verdict) restores a golden's stored physics state in a run of
+  the sync under test, syncs, renders and compares with the golden: it judges the sync and the
+  renderer, whatever pyBullet does on this machine. Frames are checked in order in one run, so what a
+  sync leaves behind from one frame (geometry it changed without telling VTK, a pose it draws a
+  frame late) shows in the next;
+* :func:`check_physics` (the *physics* verdict) compares a live run's state at each golden frame
+  with the stored one: a difference there is pyBullet or the platform, not rendering;
+* :func:`regenerate` writes goldens anew (atomically, unchanged bytes untouched) and says what
+  changed and by how much.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Iterable
+
+import numpy as np
+
+from conformance import backends, state
+from conformance.errors import GoldenError
+from conformance.rendering import golden as storage
+from conformance.rendering.records import ImageCheck
+
+__all__ = ["Change", "check_physics", "check_render", "make", "regenerate", "same_renderer", "tolerance_for"]
+
+#: The sync whose drawing the goldens show.
+GOLDEN_SYNC = "reference"
+_RENDERER_KEYS = ("backend", "vtk", "gl_vendor", "gl_renderer", "gl_version")
+
+
+def same_renderer(made_by: dict[str, str], here: dict[str, str]) -> bool:
+    """Whether a golden was made by the renderer this machine has (same OpenGL strings and VTK)."""
+    return all(made_by.get(k) == here.get(k) for k in _RENDERER_KEYS)
+
+
+def tolerance_for(golden: storage.Golden, here: dict[str, str], override: str | None = None):
+    """The image tolerance set in force for ``golden``: the one named by ``override``, else
+    ``same-renderer`` when the golden's manifest names this machine's renderer, else ``other-renderer``."""
+    from conformance.rendering import compare
+
+    if override:
+        return compare.tolerance_named(override)
+    return compare.SAME_RENDERER if same_renderer(golden.renderer, here) else compare.OTHER_RENDERER
+
+
+def manifest(run, frame: int, captured: dict[str, Any], renderer: dict[str, str]) -> dict[str, Any]:
+    scene = run.scene
+    return {
+        "format": storage.FORMAT,
+        "scene": scene.name,
+        "params": dict(scene.params),
+        "frame": frame,
+        "camera": scene.camera.as_dict(),
+        "size": list(scene.image_size),
+        "background": [1.0, 1.0, 1.0],
+        "lighting": "VTK's default headlight (follows the camera)",
+        "multisamples": backends.vtk.MULTISAMPLES,
+        "sync": GOLDEN_SYNC,
+        "renderer": renderer,
+        "versions": storage.library_versions(),
+        "state": captured,
+    }
+
+
+def make(scene_name: str, frames: Iterable[int] | None = None) -> list[tuple[int, np.ndarray, dict[str, Any]]]:
+    """Run ``scene_name`` (default parameters) with the reference sync; at each golden frame, the
+    picture and its manifest."""
+    from conformance import runner, scenes, sync
+
+    spec = scenes.get(scene_name)
+    wanted = sorted(set(spec.frames_with_goldens() if frames is None else frames))
+    renderer = backends.renderer_info()
+    made = []
+    with runner.running(scene_name, sync.load(GOLDEN_SYNC)) as run:
+        for frame in wanted:
+            run.advance(frame - run.frame)
+            image = backends.render(run.drawing, run.scene.camera, run.scene.image_size)
+            made.append((frame, image, manifest(run, frame, state.capture(run.scene), renderer)))
+    return made
+
+
+def load(directory: Path | str, scene, frame: int) -> storage.Golden:
+    """The golden of a built scene at ``frame``, validated against its parameters, camera and size."""
+    return storage.read(directory, scene.name, frame, params=dict(scene.params), camera=scene.camera.as_dict(),
+                        size=tuple(scene.image_size))
+
+
+def check_render(run, golden: storage.Golden, tolerance, *, sync: str) -> tuple[ImageCheck, dict[str, np.ndarray]]:
+    """The render verdict on one golden frame, and the pictures for a failure report."""
+    from conformance.rendering import compare
+
+    frame = golden.manifest["frame"]
+    state.restore(run.scene, golden.state)
+    run.frame = frame
+    run.sync()
+    actual = backends.render(run.drawing, run.scene.camera, run.scene.image_size)
+    record = compare.compare_images(golden.image, actual, tolerance)
+    record = dataclasses.replace(record, kind="golden", scene=run.scene.name, frame=frame, sync=sync,
+                                 params=storage._jsonable(dict(run.scene.params)))
+    record.details.setdefault("tolerance_set", tolerance.name)
+    record.details["golden"] = str(golden.png)
+    record.details["golden_renderer"] = golden.renderer
+    pictures = {"expected": golden.image, "actual": actual}
+    if not record.passed:
+        pictures["difference"] = compare.difference_image(golden.image, actual)
+    return record, pictures
+
+
+@dataclass(frozen=True)
+class PhysicsVerdict:
+    frame: int
+    difference: state.PhysicsDifference
+    chaotic: bool  # the frame is past the scene's chaotic step: another platform may differ here
+
+    def as_dict(self) -> dict[str, Any]:
+        return {"frame": self.frame, "chaotic": self.chaotic, **self.difference.as_dict()}
+
+
+def check_physics(scene_name: str, goldens: dict[int, storage.Golden]) -> list[PhysicsVerdict]:
+    """The physics verdict: the live run's state at each golden frame against the stored one. Needs
+    no sync and no renderer: a sync does not touch physics (``test_sync_does_not_touch_physics``), so
+    the goldens' states, captured in a run with the reference sync, are the bare scene's."""
+    from conformance import scenes
+
+    spec = scenes.get(scene_name)
+    verdicts = []
+    with scenes.build(scene_name) as scene:
+        done = 0
+        for frame in sorted(goldens):
+            for step in range(done, frame):
+                scene.advance(step)
+            done = frame
+            difference = state.compare(state.capture(scene), goldens[frame].state)
+            chaotic = spec.chaotic_after is not None and frame > spec.chaotic_after
+            verdicts.append(PhysicsVerdict(frame, difference, chaotic))
+    return verdicts
+
+
+@dataclass(frozen=True)
+class Change:
+    """What regenerating one golden did."""
+
+    scene: str
+    frame: int
+    status: str  # "new", "changed", "unchanged"
+    pixels: int = 0  # differing pixels against the old golden
+    largest: int = 0  # largest channel difference
+    physics: str = ""  # the physics difference against the old manifest, if it had one
+
+    def describe(self) -> str:
+        where = f"{self.scene} frame {self.frame}"
+        if self.status == "new":
+            return f"{where}: new"
+        if self.status == "unchanged":
+            return f"{where}: unchanged (byte-identical)"
+        picture = (f"{self.pixels} pixels differ (largest channel difference {self.largest})" if self.pixels
+                   else "pixels identical")
+        return f"{where}: changed: {picture}" + (f"; physics: {self.physics}" if self.physics else "")
+
+
+def regenerate(scene_name: str, directory: Path | str, *, mode: str = "all", tolerance_override: str | None = None) -> list[Change]:
+    """Make a scene's goldens anew and write those that ``mode`` selects: ``all``, ``missing``
+    (missing or unreadable), or ``failing`` (missing, unreadable, or failing the render verdict
+    with the reference sync)."""
+    from conformance import images, scenes
+
+    if mode not in ("all", "missing", "failing"):
+        raise ValueError(f"mode={mode!r}, but should be 'all', 'missing' or 'failing'")
+    changes = []
+    here = backends.renderer_info()
+    spec = scenes.get(scene_name)
+    for frame, image, made in make(scene_name):
+        try:
+            old = storage.read(directory, scene_name, frame, params=dict(spec.defaults),
+                               camera=spec.camera.as_dict(), size=tuple(spec.image_size))
+        except GoldenError:
+            old = None  # missing or unreadable: every mode makes it anew
+        if old is not None and mode == "missing":
+            continue
+        if old is not None and mode == "failing":
+            from conformance.rendering import compare
+
+            if compare.compare_images(old.image, image, tolerance_for(old, here, tolerance_override)).passed:
+                continue
+        png, _ = storage.paths(directory, scene_name, frame)
+        existed = png.exists()
+        if not storage.write(directory, scene_name, frame, image, made):
+            changes.append(Change(scene_name, frame, "unchanged"))
+            continue
+        if old is None:
+            changes.append(Change(scene_name, frame, "new" if not existed else "changed"))
+            continue
+        pixels, largest = images.difference(old.image, image) if old.image.shape == image.shape else (image.size // 3, 255)
+        physics = state.compare(made["state"], old.state)
+        changes.append(Change(scene_name, frame, "changed", pixels, largest,
+                              "" if physics.position == 0 and physics.angle == 0 else physics.describe()))
+    return changes

@@ -1,0 +1,137 @@
+"""A scene's physics state at one frame, as plain data: captured, restored, compared.
+
+A golden snapshot stores the state of the frame it shows (:mod:`conformance.rendering.golden`), so
+that its two verdicts can be told apart: *render* restores the stored state, syncs and renders,
+which judges the sync and the renderer whatever pyBullet does on this machine; *physics* compares
+a live run's state with the stored one, which tells a pyBullet or platform change from a rendering
+change.
+
+The state holds, for every body, what pyBullet needs to put it back exactly: the base's centre-of-mass
+pose and velocity (``resetBasePositionAndOrientation``/``resetBaseVelocity``, PyBullet Quickstart
+Guide, "Base, Joint, Link"), and each joint's multi-DOF position and velocity
+(``resetJointStateMultiDof``); and, for every drawn target, its link-frame pose (what a sync draws).
+Floats go through JSON as ``repr`` does, shortest round-trip, so a stored state restores bit for bit.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from conformance import truth
+
+__all__ = ["PhysicsDifference", "capture", "compare", "first_divergence", "nudged", "restore"]
+
+#: Physics verdict: a live target farther than this from its stored link-frame pose is a difference.
+#: On one machine pyBullet is bit-identical run to run (``test_scenes`` proves it), so any figure
+#: above zero means another pyBullet, platform or compiler; 1 µm and 1e-5 rad keep last-bit float
+#: noise from another platform quiet while a real change in physics (a step, a parameter) shows.
+POSITION_TOLERANCE = 1e-6
+ANGLE_TOLERANCE = 1e-5
+
+
+def capture(scene) -> dict[str, Any]:
+    """Every body's base pose, velocity and joint states, and every target's link-frame pose."""
+    p = scene.p
+    bodies = []
+    for i in range(p.getNumBodies()):
+        body = p.getBodyUniqueId(i)
+        position, orientation = p.getBasePositionAndOrientation(body)
+        linear, angular = p.getBaseVelocity(body)
+        joints = []
+        for j in range(p.getNumJoints(body)):
+            q, qdot = p.getJointStateMultiDof(body, j)[:2]
+            joints.append({"position": list(q), "velocity": list(qdot)})
+        bodies.append({"body": body, "position": list(position), "orientation": list(orientation),
+                       "linear_velocity": list(linear), "angular_velocity": list(angular), "joints": joints})
+    positions, orientations = truth.link_frames(p, [(b.body, b.link) for b in scene.bindings])
+    targets = [{"name": b.name, "body": b.body, "link": b.link, "position": positions[i].tolist(),
+                "orientation": orientations[i].tolist()} for i, b in enumerate(scene.bindings)]
+    return {"bodies": bodies, "targets": targets}
+
+
+def restore(scene, state: dict[str, Any]) -> None:
+    """Put every body of ``scene`` back in ``state`` (from :func:`capture` on the same scene)."""
+    p = scene.p
+    for entry in state["bodies"]:
+        body = entry["body"]
+        p.resetBasePositionAndOrientation(body, entry["position"], entry["orientation"])
+        p.resetBaseVelocity(body, entry["linear_velocity"], entry["angular_velocity"])
+        for j, joint in enumerate(entry["joints"]):
+            if joint["position"] or joint["velocity"]:  # fixed joints have no degrees of freedom
+                p.resetJointStateMultiDof(body, j, joint["position"], joint["velocity"])
+
+
+@dataclass(frozen=True)
+class PhysicsDifference:
+    """The largest difference between two states' target poses (the physics verdict)."""
+
+    position: float  # metres
+    angle: float  # radians
+    target: str  # the target where the larger of the two (relative to its tolerance) was seen
+
+    @property
+    def ok(self) -> bool:
+        return self.position <= POSITION_TOLERANCE and self.angle <= ANGLE_TOLERANCE
+
+    def describe(self) -> str:
+        return (f"largest difference at {self.target!r}: {self.position:.3g} m (tolerance {POSITION_TOLERANCE:g} m), "
+                f"{self.angle:.3g} rad (tolerance {ANGLE_TOLERANCE:g} rad)")
+
+    def as_dict(self) -> dict[str, Any]:
+        return {"position": self.position, "angle": self.angle, "target": self.target, "ok": self.ok,
+                "position_tolerance": POSITION_TOLERANCE, "angle_tolerance": ANGLE_TOLERANCE}
+
+
+def compare(live: dict[str, Any], stored: dict[str, Any]) -> PhysicsDifference:
+    """How far ``live`` targets are from ``stored`` ones (the same scene, the same targets)."""
+    a, b = live["targets"], stored["targets"]
+    if [t["name"] for t in a] != [t["name"] for t in b]:
+        return PhysicsDifference(float("inf"), float("inf"), "(the targets differ: other scene parameters?)")
+    pa = np.array([t["position"] for t in a], dtype=float)
+    pb = np.array([t["position"] for t in b], dtype=float)
+    qa = np.array([t["orientation"] for t in a], dtype=float)
+    qb = np.array([t["orientation"] for t in b], dtype=float)
+    distances = np.linalg.norm(pa - pb, axis=1)
+    # pyBullet's quaternions are float32 values, a few 1e-8 off unit length, so acos(|q_a · q_b|) of
+    # two equal ones reads ~1e-4 rad; 2·atan2(|q_a − s q_b|, |q_a + s q_b|) of unit quaternions (s the
+    # sign that makes them the same hemisphere: q and −q are one rotation) is exact for equal ones.
+    qa /= np.linalg.norm(qa, axis=1, keepdims=True)
+    qb /= np.linalg.norm(qb, axis=1, keepdims=True)
+    signs = np.where(np.sum(qa * qb, axis=1) < 0, -1.0, 1.0)[:, None]
+    angles = 2.0 * np.arctan2(np.linalg.norm(qa - signs * qb, axis=1), np.linalg.norm(qa + signs * qb, axis=1))
+    score = np.maximum(distances / POSITION_TOLERANCE, angles / ANGLE_TOLERANCE)
+    worst = int(np.argmax(score)) if len(score) else 0
+    return PhysicsDifference(float(distances.max(initial=0.0)), float(angles.max(initial=0.0)),
+                             a[worst]["name"] if a else "")
+
+
+def nudged(scene, distance: float = 1e-9) -> None:
+    """Move every dynamic body's base by ``distance`` along x, keeping its velocity (a reset alone
+    zeroes it): the smallest difference another platform's floating point could make."""
+    p = scene.p
+    for i in range(p.getNumBodies()):
+        body = p.getBodyUniqueId(i)
+        if p.getDynamicsInfo(body, -1)[0] > 0:
+            (x, y, z), orientation = p.getBasePositionAndOrientation(body)
+            linear, angular = p.getBaseVelocity(body)
+            p.resetBasePositionAndOrientation(body, [x + distance, y, z], orientation)
+            p.resetBaseVelocity(body, linear, angular)
+
+
+def first_divergence(scene_name: str, steps: int, distance: float = 1e-9) -> int | None:
+    """The first step after which a run nudged by ``distance`` (:func:`nudged`) differs from the
+    plain run beyond the physics verdict's tolerance, or None within ``steps``: where a scene's
+    physics turns chaotic, measured."""
+    from conformance import scenes
+
+    with scenes.build(scene_name) as plain, scenes.build(scene_name) as moved:
+        nudged(moved, distance)
+        for step in range(steps):
+            plain.advance(step)
+            moved.advance(step)
+            if not compare(capture(moved), capture(plain)).ok:
+                return step + 1
+    return None

@@ -1,0 +1,86 @@
+"""Golden snapshots: what reaches the screen is the committed picture of the physics.
+
+Every reference scene has goldens at its first frame, one in the middle of the action and its last
+(``golden/<scene>/frame-NNNN.png``, made by ``python -m conformance regen``), each with a manifest
+holding the physics state of that frame. Each golden gets two verdicts, reported separately:
+
+* ``test_golden_render``: restore the stored physics state, let the sync under test draw it, render,
+  compare with the golden within the image tolerance set in force (:mod:`conformance.rendering.compare`).
+  It judges the sync and the renderer, independent of any drift in physics. The frames are restored
+  in order in one run, so data changed without telling VTK, a frame drawn late, recoloured bodies or
+  a moved camera all show.
+* ``test_golden_physics``: the live run's state at each golden frame against the stored one: a
+  failure here is pyBullet or the platform, not rendering. Past a scene's chaotic step (the wrecking
+  ball's whip) a difference is reported as a warning, not hidden and not failed.
+"""
+
+from __future__ import annotations
+
+import shlex
+import warnings
+
+import pytest
+
+from conformance import scenes
+from conformance.errors import GoldenError
+from conformance.pytest_helpers import each_scene
+
+
+def _reproduce(check: str, scene: str, sync: str) -> str:
+    return shlex.join(["pytest", "--pyargs", "conformance", "-k", f"{check} and {scene}", "--sync", sync])
+
+
+def _goldens(pictures, scene):
+    from conformance.rendering import snapshots
+
+    try:
+        return {frame: snapshots.load(pictures.golden_dir, scene, frame)
+                for frame in scenes.get(scene.name).frames_with_goldens()}
+    except GoldenError as err:
+        pytest.fail(str(err), pytrace=False)
+
+
+@each_scene()
+def test_golden_render(scene_name, kit, pictures, request):
+    """Each golden frame, restored and drawn by the sync under test, renders as the golden within tolerance."""
+    from conformance.rendering import snapshots
+
+    if pictures.regen:
+        pictures.note_regenerated(request.node, snapshots.regenerate(scene_name, pictures.golden_dir))
+    failures = []
+    with kit.run(scene_name) as run:
+        goldens = _goldens(pictures, run.scene)
+        physics = {v.frame: v for v in snapshots.check_physics(scene_name, goldens)}
+        for frame, golden in goldens.items():
+            record, images = snapshots.check_render(run, golden, pictures.tolerance_for(golden), sync=kit.sync)
+            record.details["physics"] = physics[frame].as_dict()
+            record.reproduce = _reproduce("test_golden_render", scene_name, kit.sync)
+            record.nodeid = request.node.nodeid
+            pictures.keep(record, images)
+            if not record.passed:
+                failures.append(record)
+    if failures:
+        lines = [f"{r.message} [{scene_name}, frame {r.frame}, sync {kit.sync!r}]" for r in failures]
+        lines.append(f"pictures: {pictures.results} (report.html); reproduce: {failures[0].reproduce}")
+        pytest.fail("\n".join(lines), pytrace=False)
+
+
+@each_scene()
+def test_golden_physics(scene_name, pictures):
+    """The live run's physics state at each golden frame is the stored one (within 1 µm / 1e-5 rad)."""
+    from conformance.rendering import snapshots
+
+    with scenes.build(scene_name) as scene:
+        goldens = _goldens(pictures, scene)
+    verdicts = snapshots.check_physics(scene_name, goldens)
+    failed = [v for v in verdicts if not v.difference.ok and not v.chaotic]
+    for v in verdicts:
+        if not v.difference.ok and v.chaotic:
+            warnings.warn(f"{scene_name} frame {v.frame} (past its chaotic step {scenes.get(scene_name).chaotic_after}): "
+                          f"physics differs from the golden's stored state, {v.difference.describe()}; its render "
+                          "verdict restores the stored state and stays valid")
+    if failed:
+        pytest.fail("\n".join(f"physics differs from the golden's stored state at {scene_name} frame {v.frame}: "
+                              f"{v.difference.describe()}. The render verdict is unaffected (it restores the stored "
+                              "state); this is pyBullet or the platform. If pyBullet changed on purpose: "
+                              f"python -m conformance regen {scene_name}" for v in failed), pytrace=False)
