@@ -7,6 +7,7 @@ test, being FURY code, touch them too).
 from __future__ import annotations
 
 import hashlib
+import weakref
 from collections import defaultdict
 from dataclasses import dataclass
 from typing import Any, Sequence
@@ -195,6 +196,7 @@ def mesh_signature(actor) -> tuple[int, str, str]:
 #: Anti-aliasing samples of every picture unless a caller asks otherwise.
 MULTISAMPLES = 8
 
+_stages: "weakref.WeakKeyDictionary[Drawing, Any]" = weakref.WeakKeyDictionary()  # see _stage
 _window = None  # one off-screen render window per process, created on first use
 _connection = None  # the X connection it renders through (VTK does not close one it did not open)
 
@@ -219,11 +221,41 @@ def _render_window():
 def _release_window() -> None:
     global _window, _connection
     if _window is not None:
+        for stage in list(_stages.values()):
+            if _window.HasRenderer(stage):
+                _window.RemoveRenderer(stage)
+        _stages.clear()
         _window.Finalize()
         _window = None
     if _connection is not None:
         close_x_connection(_connection)
         _connection = None
+
+
+def _stage(drawing: Drawing):
+    """The drawing's own FURY scene, made on its first picture and kept in the process's render
+    window while the drawing lives, the way an application keeps one scene in its window.
+
+    Keeping it is what makes a picture show what a live window shows: VTK releases an actor's
+    uploaded geometry when the actor leaves a renderer, so a fresh scene per picture would upload
+    the vertex array anew every time, and a sync that changed vertices without ``Modified()`` would
+    look right here while a live window goes on drawing the old ones."""
+    stage = _stages.get(drawing)
+    if stage is None:
+        from fury import window
+
+        stage = window.Scene()
+        for actor in drawing.actors.values():
+            stage.add(actor)
+        _stages[drawing] = stage
+        weakref.finalize(drawing, _drop_stage, stage)
+    return stage
+
+
+def _drop_stage(stage) -> None:
+    if _window is not None and _window.HasRenderer(stage):
+        _window.RemoveRenderer(stage)
+    stage.clear()
 
 
 def render(drawing: Drawing, camera, size: tuple[int, int], *, background=(1.0, 1.0, 1.0),
@@ -232,26 +264,27 @@ def render(drawing: Drawing, camera, size: tuple[int, int], *, background=(1.0, 
 
     The camera is applied whole (position, focal point, view up, vertical view angle and the clipping
     range, which is set after FURY's ``set_camera`` resets it to the scene's bounds). The light is
-    VTK's default headlight, which follows the camera; ``multisamples`` is the anti-aliasing.
+    VTK's default headlight, which follows the camera; ``multisamples`` is the anti-aliasing. The
+    drawing keeps one scene in the render window from picture to picture (:func:`_stage`).
     """
     ensure_display()
     from fury import window
 
-    stage = window.Scene()
+    stage = _stage(drawing)
     stage.background(background)
-    for actor in drawing.actors.values():
-        stage.add(actor)
     _set_camera(stage, camera)
     render_window = _render_window()
     render_window.SetMultiSamples(multisamples)
-    render_window.AddRenderer(stage)
+    if not render_window.HasRenderer(stage):
+        render_window.AddRenderer(stage)
+    renderers = render_window.GetRenderers()
+    renderers.InitTraversal()
+    for _ in range(renderers.GetNumberOfItems()):
+        other = renderers.GetNextItem()
+        other.SetDraw(other is stage)  # other drawings' scenes stay, undrawn
     render_window.SetSize(*size)
-    try:
-        render_window.Render()
-        return window.snapshot(stage, size=tuple(size), render_window=render_window)
-    finally:
-        render_window.RemoveRenderer(stage)
-        stage.clear()
+    render_window.Render()
+    return window.snapshot(stage, size=tuple(size), render_window=render_window)
 
 
 def _set_camera(stage, camera) -> None:

@@ -243,12 +243,12 @@ def render_frames(scene: str, *, variants: bool = True) -> dict[tuple[int, str],
 
 
 def _table(scene_names, rerender_of) -> str:
-    from conformance.rendering.compare import OTHER_RENDERER, SAME_RENDERER, _differing, flip_mean
+    from conformance.rendering.compare import OTHER_RENDERER, SAME_RENDERER, _differing, compare_images, flip_mean
 
     header = ("| scene | change | same-renderer: pixels > 2 | other-renderer: pixels > 32 in 2x2 blocks "
               "| other-renderer: pixels > 4 in 3x3 blocks (shade) | raw pixels > 32 | FLIP mean |\n"
               "|---|---|---|---|---|---|---|\n")
-    lines, overall = [], {}
+    lines, overall, verdicts = [], {}, {}
     for scene in scene_names:
         images = render_frames(scene)
         stats: dict[str, list[tuple[float, ...]]] = {}
@@ -259,6 +259,8 @@ def _table(scene_names, rerender_of) -> str:
             variants["rerender"] = rerender_of[scene, frame]
             variants["noise"] = with_noise(image, seed=frame)
             for change, other in variants.items():
+                verdicts.setdefault(change, []).append(
+                    (compare_images(image, other, SAME_RENDERER).passed, compare_images(image, other, OTHER_RENDERER).passed))
                 row = (_differing(image, other, SAME_RENDERER.pixel_threshold, SAME_RENDERER.block).sum(),
                        _differing(image, other, OTHER_RENDERER.pixel_threshold, OTHER_RENDERER.block).sum(),
                        _differing(image, other, OTHER_RENDERER.shade_threshold, 3).sum(),
@@ -283,7 +285,12 @@ def _table(scene_names, rerender_of) -> str:
         cells = [f"{cols[:, c].min():.0f}–{cols[:, c].max():.0f}" for c in range(4)]
         cells.append(f"{cols[:, 4].min():.5f}–{cols[:, 4].max():.5f}")
         summary.append(f"| {change} | " + " | ".join(cells) + " |")
-    return "\n".join(summary) + "\n\nPer scene (min–max over the golden frames):\n\n" + header + "\n".join(lines) + "\n"
+    passed = ["", "Verdicts of `compare_images` on every case above (passed / cases):", "",
+              "| change | same-renderer | other-renderer |", "|---|---|---|"]
+    for change in BENIGN + ERRORS:
+        cases = verdicts.get(change, [])
+        passed.append(f"| {change} | {sum(s for s, _ in cases)} / {len(cases)} | {sum(o for _, o in cases)} / {len(cases)} |")
+    return "\n".join(summary + passed) + "\n\nPer scene (min–max over the golden frames):\n\n" + header + "\n".join(lines) + "\n"
 
 
 def _timing() -> float:
