@@ -69,9 +69,7 @@ def _cmd_render(args, extra) -> int:
 
 
 def _render_one(name: str, args) -> None:
-    from PIL import Image
-
-    from conformance import backends, runner, scenes, sync
+    from conformance import backends, files, runner, scenes, sync
 
     spec = scenes.get(name)
     step = (spec.poster_step or spec.steps) if args.step is None else args.step
@@ -80,10 +78,7 @@ def _render_one(name: str, args) -> None:
         run.advance(step)
         size = tuple(args.size) if args.size else run.scene.image_size
         image = backends.render(run.drawing, run.scene.camera, size)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = out.with_name(out.name + ".tmp")
-    Image.fromarray(image).save(tmp, format="PNG")
-    tmp.replace(out)  # never leave a half-written picture under the final name
+    files.write_atomically(out, files.encode_png(image))  # never a half-written picture under the final name
     print(f"wrote {out} ({size[0]}x{size[1]}, scene {name!r} at step {step}, sync {args.sync!r})")
 
 

@@ -77,6 +77,7 @@ class Pictures:
         """Write a check's pictures (failures always; passes when asked) and its record."""
         from conformance.rendering import artefacts
 
+        record.details.setdefault("renderer", self.renderer)
         artefacts.write_artefacts(record, self.results, images if (not record.passed or self.keep_passing) else {})
         self.kept += 1
 
@@ -108,7 +109,13 @@ class Pictures:
         records = artefacts.read_records(self.results)
         if not records:
             return None
-        header = [f"sync under test: {sync}", self.describe()]
+        from conformance.rendering import golden
+
+        versions = ", ".join(f"{name} {version}" for name, version in golden.library_versions().items())
+        renderers = sorted({" / ".join(r["details"]["renderer"].get(k, "?") for k in ("gl_vendor", "gl_renderer", "gl_version"))
+                            for r in (record.to_json() for record in records) if "renderer" in r["details"]})
+        header = [f"sync under test: {sync}", f"versions: {versions}",
+                  *(f"renderer: {r}" for r in renderers), self.describe()]
         self.report_path = report.write_report(records, self.results, title="FURY–pyBullet image checks",
                                                header_lines=header)
         return self.report_path

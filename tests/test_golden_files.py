@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from conformance.errors import GoldenError, GoldenMissing, GoldenUnreadable
+from conformance import files
 from conformance.rendering import golden
 
 SCENE, FRAME, SIZE = "free_fall", 60, (12, 8)
@@ -59,8 +60,8 @@ def test_rewriting_the_same_golden_changes_no_byte_and_touches_no_file(stored):
 
 
 def test_png_bytes_depend_only_on_the_pixels():
-    assert golden.encode_png(_picture()) == golden.encode_png(_picture().copy())
-    assert b"tIME" not in golden.encode_png(_picture()) and b"tEXt" not in golden.encode_png(_picture())
+    assert files.encode_png(_picture()) == files.encode_png(_picture().copy())
+    assert b"tIME" not in files.encode_png(_picture()) and b"tEXt" not in files.encode_png(_picture())
 
 
 def test_files_are_ordinary_readable_files(stored):
@@ -75,7 +76,7 @@ def test_a_failed_write_leaves_the_old_golden_whole_and_no_temporary_file(stored
     def crash(src, dst):
         raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr(golden.os, "replace", crash)
+    monkeypatch.setattr(files.os, "replace", crash)
     with pytest.raises(OSError, match="No space left"):
         golden.write(stored, SCENE, FRAME, _picture(seed=2), _manifest())
     assert _snapshot(stored) == before
@@ -101,7 +102,7 @@ def _damage(directory, which, data: bytes):
 @pytest.mark.parametrize("damage, message", [
     (lambda d: _damage(d, 0, golden.paths(d, SCENE, FRAME)[0].read_bytes()[:60]), r"is damaged or truncated"),
     (lambda d: _damage(d, 0, b"GIF89a not a png at all"), r"is not a PNG \(its first bytes are b'GIF89a n'\)"),
-    (lambda d: _damage(d, 0, golden.encode_png(np.zeros((9, 12, 3), np.uint8))), r"is 12x9 pixels, but the scene renders 12x8"),
+    (lambda d: _damage(d, 0, files.encode_png(np.zeros((9, 12, 3), np.uint8))), r"is 12x9 pixels, but the scene renders 12x8"),
     (lambda d: _damage(d, 1, b"{ not json"), r"has a manifest that is not valid JSON"),
     (lambda d: _damage(d, 1, b"[]"), r"has a manifest without format, scene"),
     (lambda d: _damage(d, 1, json.dumps({k: v for k, v in _manifest().items() if k != "state"}).encode()),

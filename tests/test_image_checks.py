@@ -110,11 +110,13 @@ def test_wrong_camera_fails_the_silhouette_check(wrong):
     assert_some_fail(silhouette_verdicts("reference", "free_fall", camera=camera), f"camera {wrong}")
 
 
-@pytest.mark.parametrize("spec", ["reference", "right_syncs:PositionOrientationSync", "right_syncs:IncrementalSync"])
-@pytest.mark.parametrize("scene", ["brick_wall_single", "chain", "free_fall", "pendulum", "domino"])
+@pytest.mark.parametrize("spec", ["reference", "right_syncs:PositionOrientationSync", "right_syncs:IncrementalSync",
+                                  "right_syncs:vectorised_vertex_sync"])
+@pytest.mark.parametrize("scene", ["brick_wall_single", "chain", "free_fall", "pendulum", "mixed_shapes"])
 def test_right_syncs_pass_every_image_check(spec, scene):
-    tolerance = compare.SAME_RENDERER if spec == "reference" else compare.OTHER_RENDERER
-    assert_all_pass(golden_verdicts(spec, scene, tolerance), f"{spec} on {scene}")
+    """Right syncs in other styles pass even the tight same-renderer set: their float rounding, within
+    the vertex tolerance, flips at most a few edge pixels (22 on mixed_shapes frame 360, against 40)."""
+    assert_all_pass(golden_verdicts(spec, scene, compare.SAME_RENDERER), f"{spec} on {scene}")
     assert_all_pass(silhouette_verdicts(spec, scene), f"{spec} on {scene}")
 
 

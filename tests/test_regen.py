@@ -9,7 +9,7 @@ import sys
 import numpy as np
 import pytest
 
-from conformance import cli
+from conformance import cli, files
 from conformance.rendering import golden
 
 SCENE = "free_fall"
@@ -71,7 +71,7 @@ def test_regen_failing_remakes_a_wrong_golden_and_says_by_how_much(made, capsys,
 
     picture = np.asarray(Image.open(png)).copy()
     picture[10:20, 10:30] = (255, 0, 0)  # 200 pixels painted red
-    png.write_bytes(golden.encode_png(picture))
+    png.write_bytes(files.encode_png(picture))
     assert cli.main(["regen", SCENE, "--failing", "--golden-dir", str(copy)]) == 0
     out = capsys.readouterr().out
     assert "free_fall frame 120: changed: 200 pixels differ" in out, out

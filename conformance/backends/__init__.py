@@ -10,13 +10,14 @@ The rest of the kit talks to a backend only through these functions:
 * ``render(drawing, camera, size, *, multisamples) -> (h, w, 3) uint8``: an off-screen picture;
 * ``render_ids(drawing, camera, size) -> (h, w) int32``: each pixel's target index (-1 background),
   every target drawn flat in its own colour (the silhouette check against pyBullet's renderer);
-* ``renderer_info() -> dict``: what draws the pictures (OpenGL vendor/renderer/version, VTK version).
+* ``renderer_info() -> dict``: what draws the pictures (OpenGL vendor/renderer/version, VTK version);
+* ``MULTISAMPLES``: the anti-aliasing every picture is made with unless asked otherwise.
 
 FURY 0.12 (VTK) is the only backend today; FURY 2.x (pygfx) would be a sibling module.
 """
 
 from __future__ import annotations
 
-from .vtk import Drawing, build, content_state, mesh_signature, render, render_ids, renderer_info, world_normals, world_vertices
+from .vtk import MULTISAMPLES, Drawing, build, content_state, mesh_signature, render, render_ids, renderer_info, world_normals, world_vertices
 
-__all__ = ["Drawing", "build", "content_state", "mesh_signature", "render", "render_ids", "renderer_info", "world_normals", "world_vertices"]
+__all__ = ["MULTISAMPLES", "Drawing", "build", "content_state", "mesh_signature", "render", "render_ids", "renderer_info", "world_normals", "world_vertices"]

@@ -14,7 +14,6 @@ from typing import Any, Sequence
 
 import numpy as np
 from vtkmodules.util import numpy_support
-from vtkmodules.vtkCommonMath import vtkMatrix4x4
 
 from conformance import poses, truth
 from conformance.display import close_x_connection, ensure_display, on_stop, x_connection

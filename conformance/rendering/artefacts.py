@@ -23,7 +23,6 @@ import json
 import os
 import re
 import shutil
-import tempfile
 import warnings
 from pathlib import Path
 from typing import Any, Mapping
@@ -31,6 +30,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from conformance.errors import InvalidArgument
+from conformance.files import encode_png, write_atomically
 from conformance.rendering.records import KINDS, ImageCheck
 
 __all__ = [
@@ -95,20 +95,9 @@ def write_png(path: str | os.PathLike, picture: np.ndarray) -> Path:
     The same array always gives the same bytes (for a given Pillow and zlib): no tIME, tEXt or pHYs
     chunk is written and the compression level is fixed.
     """
-    from PIL import Image
-
     path = Path(path)
-    image = Image.fromarray(_as_rgb(picture, what=path.name))
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            image.save(fh, format="PNG", compress_level=6, optimize=False)
-        os.replace(tmp, path)  # several workers may write the same picture: the last complete one wins
-    except BaseException:
-        _remove(tmp)
-        raise
-    return path
+    # Several workers may write the same picture: the last complete one wins.
+    return write_atomically(path, encode_png(_as_rgb(picture, what=path.name)))
 
 
 def _as_rgb(picture: np.ndarray, *, what: str) -> np.ndarray:

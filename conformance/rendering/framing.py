@@ -13,7 +13,6 @@ from __future__ import annotations
 
 from typing import Collection
 
-import numpy as np
 
 from . import projection
 from .records import ImageCheck

@@ -22,9 +22,7 @@ from __future__ import annotations
 import importlib.metadata as md
 import io
 import json
-import os
 import shlex
-import tempfile
 import zlib
 from dataclasses import dataclass
 from pathlib import Path
@@ -33,9 +31,10 @@ from typing import Any
 import numpy as np
 
 from conformance.errors import GoldenMissing, GoldenUnreadable
+from conformance.files import encode_png, write_atomically
 
 __all__ = ["FORMAT", "Golden", "default_dir", "library_versions", "paths", "read", "regen_command",
-           "write", "encode_png"]
+           "write", "encode_manifest"]
 
 #: The manifest format; bumped when its meaning changes, so an old manifest is refused, not misread.
 FORMAT = 1
@@ -146,15 +145,6 @@ def read(directory: Path | str, scene: str, frame: int, *, params: dict[str, Any
     return Golden(image=image, manifest=manifest, png=png)
 
 
-def encode_png(image: np.ndarray) -> bytes:
-    """PNG bytes that depend only on the pixels: no time, text or software chunks."""
-    from PIL import Image
-
-    buffer = io.BytesIO()
-    Image.fromarray(np.ascontiguousarray(image, dtype=np.uint8)).save(buffer, format="PNG", optimize=True)
-    return buffer.getvalue()
-
-
 def encode_manifest(manifest: dict[str, Any]) -> bytes:
     """Sorted keys, one line per setting, and one line per body and per target in the state: readable
     in a diff, and small (a state of a hundred bodies is tens of kilobytes)."""
@@ -171,27 +161,6 @@ def encode_manifest(manifest: dict[str, Any]) -> bytes:
     return (text + "\n").encode("utf-8")
 
 
-def _write_atomically(path: Path, data: bytes) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        os.fchmod(fd, 0o666 & ~_umask())  # mkstemp makes 0600; a golden is an ordinary file of the checkout
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
-
-
 def write(directory: Path | str, scene: str, frame: int, image: np.ndarray, manifest: dict[str, Any]) -> bool:
     """Write a golden and its manifest atomically; return whether any byte changed. Unchanged files
     are not touched. The manifest is written last, so a reader never pairs a new manifest with an
@@ -201,6 +170,6 @@ def write(directory: Path | str, scene: str, frame: int, image: np.ndarray, mani
     for path, data in ((png, encode_png(image)), (manifest_path, encode_manifest(manifest))):
         if path.exists() and path.read_bytes() == data:
             continue
-        _write_atomically(path, data)
+        write_atomically(path, data)
         changed = True
     return changed

@@ -25,10 +25,10 @@ import html
 import json
 import math
 import os
-import tempfile
 from pathlib import Path
 from typing import Any, Iterable
 
+from conformance.files import write_atomically
 from conformance.rendering.artefacts import ROLES, _jsonable
 from conformance.rendering.records import KINDS, ImageCheck
 
@@ -263,17 +263,7 @@ def write_report(records: Iterable[ImageCheck], results_dir: str | os.PathLike, 
     """Write the page to ``results_dir/filename`` atomically and return its path."""
     results_dir = Path(results_dir)
     page = render_report(records, results_dir, title=title, header_lines=header_lines)
-    results_dir.mkdir(parents=True, exist_ok=True)
-    path = results_dir / filename
-    fd, tmp = tempfile.mkstemp(prefix=f".{filename}.", suffix=".tmp", dir=results_dir)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(page)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
+    return write_atomically(results_dir / filename, page.encode("utf-8"))
 
 
 _CSS = """

@@ -61,7 +61,7 @@ def manifest(run, frame: int, captured: dict[str, Any], renderer: dict[str, str]
         "size": list(scene.image_size),
         "background": [1.0, 1.0, 1.0],
         "lighting": "VTK's default headlight (follows the camera)",
-        "multisamples": backends.vtk.MULTISAMPLES,
+        "multisamples": backends.MULTISAMPLES,
         "sync": GOLDEN_SYNC,
         "renderer": renderer,
         "versions": storage.library_versions(),
