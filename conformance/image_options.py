@@ -57,7 +57,6 @@ class Pictures:
     keep_passing: bool
     regen: bool
     _renderer: dict[str, str] | None = field(default=None, repr=False)
-    kept: int = 0
 
     # -- the checks' side ---------------------------------------------------------------------
     @property
@@ -79,7 +78,6 @@ class Pictures:
 
         record.details.setdefault("renderer", self.renderer)
         artefacts.write_artefacts(record, self.results, images if (not record.passed or self.keep_passing) else {})
-        self.kept += 1
 
     def note_regenerated(self, node, changes) -> None:
         for change in changes:
