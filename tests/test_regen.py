@@ -114,3 +114,23 @@ def test_regen_golden_option_under_xdist_does_not_race(tmp_path, made):
     for frame in (0, 60, 120):  # what the pytest option made is what the command made
         for path_made, path_here in zip(golden.paths(made, SCENE, frame), golden.paths(directory, SCENE, frame)):
             assert path_made.read_bytes() == path_here.read_bytes()
+
+
+def test_physics_verdict_fails_on_a_stored_state_that_is_not_pybullets(made):
+    """The physics verdict compares the live run with the manifest's state: a target moved by 2 µm in
+    the stored state is a difference (1 µm tolerance), and an untouched golden is none."""
+    from conformance.rendering import snapshots
+
+    def goldens():
+        return {f: golden.read(made, SCENE, f, params=dict(spec.defaults), camera=spec.camera.as_dict(),
+                               size=tuple(spec.image_size)) for f in spec.frames_with_goldens()}
+
+    from conformance import scenes
+
+    spec = scenes.get(SCENE)
+    assert all(v.difference.ok and not v.chaotic for v in snapshots.check_physics(SCENE, goldens()))
+    tampered = goldens()
+    tampered[60].state["targets"][0]["position"][2] += 2e-6
+    verdicts = {v.frame: v for v in snapshots.check_physics(SCENE, tampered)}
+    assert not verdicts[60].difference.ok and verdicts[0].difference.ok
+    assert "2e-06 m (tolerance 1e-06 m)" in verdicts[60].difference.describe()
