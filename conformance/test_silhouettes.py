@@ -9,8 +9,6 @@ for that to mean something (``rendering.framing``).
 
 from __future__ import annotations
 
-import json
-
 import pytest
 from hypothesis import given, strategies as st
 
@@ -18,7 +16,7 @@ from conformance import backends, scenes, strategies
 from conformance.events import Teleport
 from conformance.profiles import check_settings
 from conformance.pytest_helpers import _context, each_scene, reproduce_command
-from conformance.rendering import framing, silhouettes
+from conformance.rendering import framing, golden, silhouettes
 
 #: Targets the framing check excuses, and why.
 FRAMING_EXCEPTIONS = {
@@ -40,7 +38,7 @@ def silhouette_check(run, sync: str, pictures=None, nodeid: str = ""):
         ids_fury, ids_bullet, min_iou=silhouettes.thresholds(scene.bindings),
         names=[t.name for t in run.drawing.targets], scene=scene.name, frame=run.frame)
     record.sync = sync
-    record.params = json.loads(json.dumps(dict(run.params)))
+    record.params = golden.jsonable(dict(run.params))
     record.reproduce = reproduce_command(scene.name, sync, run.frame, run.params, run.events)
     record.nodeid = nodeid
     if pictures is not None:

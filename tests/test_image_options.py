@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
@@ -41,3 +42,15 @@ def test_header_names_the_automatic_choice_and_the_results(tmp_path):
     assert run.returncode == 0, run.stdout[-2000:]
     assert "image tolerance auto (same-renderer for goldens this machine's renderer made, else other-renderer)" in run.stdout
     assert f"results in {tmp_path / 'conformance-results'}" in run.stdout
+
+
+@pytest.mark.parametrize("chosen", ["same-renderer", "other-renderer"])
+def test_forced_tolerance_set_is_used_by_the_golden_render_check(tmp_path, chosen):
+    results = tmp_path / "results"
+    run = subprocess.run([sys.executable, "-m", "pytest", "--pyargs", "conformance", "-p", "no:cacheprovider", "-q",
+                          "-k", "test_golden_render and free_fall", "--conformance-image-tolerance", chosen,
+                          "--conformance-results", str(results)],
+                         cwd=tmp_path, env=dict(os.environ), capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stdout[-2000:] + run.stderr[-2000:]
+    records = [json.loads(line) for path in results.glob("records-*.jsonl") for line in path.read_text().splitlines()]
+    assert records and {r["details"]["tolerance_set"] for r in records} == {chosen}

@@ -33,7 +33,7 @@ import numpy as np
 from conformance.errors import GoldenMissing, GoldenUnreadable
 from conformance.files import encode_png, write_atomically
 
-__all__ = ["FORMAT", "Golden", "default_dir", "library_versions", "paths", "read", "regen_command",
+__all__ = ["FORMAT", "Golden", "default_dir", "library_versions", "paths", "jsonable", "read", "regen_command",
            "write", "encode_manifest"]
 
 #: The manifest format; bumped when its meaning changes, so an old manifest is refused, not misread.
@@ -52,9 +52,8 @@ def paths(directory: Path | str, scene: str, frame: int) -> tuple[Path, Path]:
     return base.with_suffix(".png"), base.with_suffix(".json")
 
 
-def regen_command(scene: str, *, frame: int | None = None) -> str:
-    """The command that (re)makes a scene's goldens."""
-    del frame  # every golden frame of a scene is made together: they share one run
+def regen_command(scene: str) -> str:
+    """The command that (re)makes a scene's goldens (all its frames together: they share one run)."""
     return shlex.join(["python", "-m", "conformance", "regen", scene])
 
 
@@ -68,7 +67,7 @@ def library_versions() -> dict[str, str]:
     return versions
 
 
-def _jsonable(value: Any) -> Any:
+def jsonable(value: Any) -> Any:
     """Parameters as JSON holds them (tuples become lists), for storing and comparing alike."""
     return json.loads(json.dumps(value))
 
@@ -132,7 +131,7 @@ def read(directory: Path | str, scene: str, frame: int, *, params: dict[str, Any
         raise _unreadable(manifest_path, scene, f"has a manifest without {', '.join(absent)}")
     if manifest["format"] != FORMAT:
         raise _unreadable(manifest_path, scene, f"has manifest format {manifest['format']!r}, but this kit reads format {FORMAT}")
-    expected = {"scene": scene, "frame": frame, "params": _jsonable(params), "camera": _jsonable(camera),
+    expected = {"scene": scene, "frame": frame, "params": jsonable(params), "camera": jsonable(camera),
                 "size": list(size)}
     for key, value in expected.items():
         if manifest[key] != value:
@@ -148,7 +147,7 @@ def read(directory: Path | str, scene: str, frame: int, *, params: dict[str, Any
 def encode_manifest(manifest: dict[str, Any]) -> bytes:
     """Sorted keys, one line per setting, and one line per body and per target in the state: readable
     in a diff, and small (a state of a hundred bodies is tens of kilobytes)."""
-    data = _jsonable(manifest)
+    data = jsonable(manifest)
     state = data.pop("state", None)
     text = json.dumps(data, indent=1, sort_keys=True)
     if state is not None:

@@ -19,7 +19,7 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Iterable
+from typing import Any
 
 import numpy as np
 
@@ -46,7 +46,7 @@ def tolerance_for(golden: storage.Golden, here: dict[str, str], override: str | 
     from conformance.rendering import compare
 
     if override:
-        return compare.tolerance_named(override)
+        return compare.tolerance(override)
     return compare.SAME_RENDERER if same_renderer(golden.renderer, here) else compare.OTHER_RENDERER
 
 
@@ -69,13 +69,12 @@ def manifest(run, frame: int, captured: dict[str, Any], renderer: dict[str, str]
     }
 
 
-def make(scene_name: str, frames: Iterable[int] | None = None) -> list[tuple[int, np.ndarray, dict[str, Any]]]:
+def make(scene_name: str) -> list[tuple[int, np.ndarray, dict[str, Any]]]:
     """Run ``scene_name`` (default parameters) with the reference sync; at each golden frame, the
     picture and its manifest."""
     from conformance import runner, scenes, sync
 
-    spec = scenes.get(scene_name)
-    wanted = sorted(set(spec.frames_with_goldens() if frames is None else frames))
+    wanted = sorted(set(scenes.get(scene_name).frames_with_goldens()))
     renderer = backends.renderer_info()
     made = []
     with runner.running(scene_name, sync.load(GOLDEN_SYNC)) as run:
@@ -103,7 +102,7 @@ def check_render(run, golden: storage.Golden, tolerance, *, sync: str) -> tuple[
     actual = backends.render(run.drawing, run.scene.camera, run.scene.image_size)
     record = compare.compare_images(golden.image, actual, tolerance)
     record = dataclasses.replace(record, kind="golden", scene=run.scene.name, frame=frame, sync=sync,
-                                 params=storage._jsonable(dict(run.scene.params)))
+                                 params=storage.jsonable(dict(run.scene.params)))
     record.details.setdefault("tolerance_set", tolerance.name)
     record.details["golden"] = str(golden.png)
     record.details["golden_renderer"] = golden.renderer
