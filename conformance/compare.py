@@ -5,11 +5,10 @@ The pytest checks turn records into pass/fail; the command line and reports prin
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
-from typing import Sequence
 
 import numpy as np
-import pybullet
 
 from conformance import backends, poses, shapes, truth
 from conformance.backends import Drawing
@@ -62,27 +61,81 @@ class VertexResult:
                 f"{fmt(self.expected)}: error {self.error:.3g} m {'<=' if self.ok else '>'} tolerance {self.tolerance:.3g} m")
 
 
+class _Layout:
+    """A drawing's targets grouped by vertex count, with what does not change between frames: the
+    stacked reference geometry and normals, and each target's extent (for its tolerance). Built
+    once per drawing, so a frame's comparison is a few array operations per group, not per target."""
+
+    def __init__(self, drawing: Drawing):
+        by_count: dict[int, list[int]] = {}
+        for i, local in enumerate(drawing.local):
+            by_count.setdefault(len(local), []).append(i)
+        self.groups = [(np.array(rows), np.stack([drawing.local[i] for i in rows])) for rows in by_count.values()]
+        self.extents = np.array([float(np.max(np.linalg.norm(local, axis=1))) if len(local) else 0.0
+                                 for local in drawing.local])
+        lit = [i for i, normals in enumerate(drawing.local_normals) if normals is not None]
+        by_count = {}
+        for i in lit:
+            by_count.setdefault(len(drawing.local_normals[i]), []).append(i)
+        self.normal_groups = [(np.array(rows), np.stack([drawing.local_normals[i] for i in rows]))
+                              for rows in by_count.values()]
+
+
+_layouts: "weakref.WeakKeyDictionary[Drawing, _Layout]" = weakref.WeakKeyDictionary()
+
+
+def _layout(drawing: Drawing) -> _Layout:
+    layout = _layouts.get(drawing)
+    if layout is None:
+        layout = _layouts[drawing] = _Layout(drawing)
+    return layout
+
+
+def _gather(drawing: Drawing, rows, read) -> np.ndarray:
+    """The drawn data of targets ``rows`` (equal vertex counts), stacked: ``read(actor)`` once per actor."""
+    cache = {}
+    parts = []
+    for i in rows:
+        t = drawing.targets[i]
+        if id(t.actor) not in cache:
+            cache[id(t.actor)] = read(t.actor)
+        part = cache[id(t.actor)][t.start:t.stop]
+        if len(part) != t.stop - t.start:  # the sync shrank the actor: its missing vertices are drawn nowhere
+            part = np.concatenate([part, np.full((t.stop - t.start - len(part), 3), np.nan)])
+        parts.append(part)
+    return np.stack(parts)
+
+
 def compare_vertices(drawing: Drawing, frame: int, tolerance: Tolerance = DEFAULT) -> list[VertexResult]:
     """One record per target: the worst vertex of what the renderer draws vs pybullet's pose."""
     targets = drawing.targets
     positions, orientations = truth.link_frames(drawing.world.p, [(t.body, t.link) for t in targets])
     rotations = poses.matrices(orientations)
+    layout = _layout(drawing)
     drawn = {}
-    results = []
-    for i, t in enumerate(targets):
-        if id(t.actor) not in drawn:
-            drawn[id(t.actor)] = backends.world_vertices(t.actor)
-        actual = drawn[id(t.actor)][t.start:t.stop]
-        expected = drawing.local[i] @ rotations[i].T + positions[i]
-        errors = np.linalg.norm(actual - expected, axis=1)
+
+    def read(actor):
+        if id(actor) not in drawn:
+            drawn[id(actor)] = backends.world_vertices(actor)
+        return drawn[id(actor)]
+
+    tolerances = tolerance.for_extents(layout.extents, positions)
+    results: list[VertexResult | None] = [None] * len(targets)
+    for rows, local in layout.groups:
+        actual = _gather(drawing, rows, read)
+        expected = np.einsum("nij,nkj->nki", rotations[rows], local) + positions[rows][:, None, :]
+        errors = np.linalg.norm(actual - expected, axis=2)
         errors = np.where(np.isfinite(errors), errors, np.inf)
-        worst = int(np.argmax(errors)) if len(errors) else 0
-        results.append(VertexResult(
-            scene=drawing.world.scene, target=t.name, body=t.body, link=t.link, frame=frame,
-            error=float(errors[worst]) if len(errors) else 0.0,
-            tolerance=tolerance.for_geometry(drawing.local[i], positions[i]),
-            vertex=worst, expected=tuple(map(float, expected[worst])), actual=tuple(map(float, actual[worst])),
-        ))
+        worst = np.argmax(errors, axis=1) if errors.shape[1] else np.zeros(len(rows), dtype=int)
+        for k, i in enumerate(rows):
+            t, w = targets[i], int(worst[k])
+            empty = not errors.shape[1]
+            results[i] = VertexResult(
+                scene=drawing.world.scene, target=t.name, body=t.body, link=t.link, frame=frame,
+                error=0.0 if empty else float(errors[k, w]), tolerance=float(tolerances[i]), vertex=w,
+                expected=(0.0, 0.0, 0.0) if empty else tuple(map(float, expected[k, w])),
+                actual=(0.0, 0.0, 0.0) if empty else tuple(map(float, actual[k, w])),
+            )
     return results
 
 
@@ -153,24 +206,36 @@ class NormalResult:
 
 def compare_normals(drawing: Drawing, frame: int, tolerance: Tolerance = DEFAULT) -> list[NormalResult]:
     """Targets whose actor stores vertex normals: they must turn with the body."""
-    results = []
+    layout = _layout(drawing)
+    if not layout.normal_groups:
+        return []
     _, orientations = truth.link_frames(drawing.world.p, [(t.body, t.link) for t in drawing.targets])
+    rotations = poses.matrices(orientations)
     lit = {}
-    for i, t in enumerate(drawing.targets):
-        if drawing.local_normals[i] is None:
+
+    def read(actor):
+        if id(actor) not in lit:
+            lit[id(actor)] = backends.world_normals(actor)
+        return lit[id(actor)]
+
+    results = {}
+    for rows, local in layout.normal_groups:
+        stored = np.array([read(drawing.targets[i].actor) is not None for i in rows])
+        for i in rows[~stored]:  # the actor stores no normals (any more): nothing turns with the body
+            results[int(i)] = NormalResult(drawing.world.scene, drawing.targets[i].name, frame, float("inf"),
+                                           tolerance.normal_angle, 0)
+        rows, local = rows[stored], local[stored]
+        if not len(rows):
             continue
-        if id(t.actor) not in lit:
-            lit[id(t.actor)] = backends.world_normals(t.actor)
-        actual = lit[id(t.actor)]
-        if actual is None:
-            results.append(NormalResult(drawing.world.scene, t.name, frame, float("inf"), tolerance.normal_angle, 0))
-            continue
-        expected = truth.expected_vertices(drawing.local_normals[i], np.zeros(3), orientations[i])
-        cosines = np.einsum("ij,ij->i", actual[t.start:t.stop], expected / np.linalg.norm(expected, axis=1, keepdims=True))
+        actual = _gather(drawing, rows, read)
+        expected = np.einsum("nij,nkj->nki", rotations[rows], local)
+        cosines = np.einsum("nkj,nkj->nk", actual, expected / np.linalg.norm(expected, axis=2, keepdims=True))
         angles = np.arccos(np.clip(np.nan_to_num(cosines, nan=-1.0), -1.0, 1.0))
-        worst = int(np.argmax(angles))
-        results.append(NormalResult(drawing.world.scene, t.name, frame, float(angles[worst]), tolerance.normal_angle, worst))
-    return results
+        worst = np.argmax(angles, axis=1)
+        for k, i in enumerate(rows):
+            results[int(i)] = NormalResult(drawing.world.scene, drawing.targets[i].name, frame,
+                                           float(angles[k, worst[k]]), tolerance.normal_angle, int(worst[k]))
+    return [results[i] for i in sorted(results)]
 
 
 @dataclass(frozen=True)

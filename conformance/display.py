@@ -1,7 +1,23 @@
 """A virtual X display for off-screen rendering when none is set, and connections to it.
 
-VTK 9.3's wheels render through X (GLX) only, so without ``DISPLAY`` the kit starts Xvfb through
-PyVirtualDisplay, once per process, and stops it at exit (or when the pytest session ends).
+VTK 9.3's wheels render through X (GLX) only, so without ``DISPLAY`` the kit starts its own Xvfb,
+once per process, and stops it at exit (or when the pytest session ends). What is guaranteed:
+
+* ``DISPLAY`` set: the kit uses it and never starts or stops a server.
+* The Xvfb the kit starts dies with the process that started it, however that process ends: an
+  orderly exit stops it (``atexit``, :func:`stop_display`, :func:`virtual_display`); ``SIGTERM``
+  (what CI sends a cancelled or timed-out job) stops it through a handler installed while the kit
+  owns a display, after which the process dies of ``SIGTERM`` as it would have (status 128+15); and
+  any other death (``SIGKILL``, a crash) reaches Xvfb as ``SIGTERM`` through the kernel's
+  parent-death signal (Linux ``PR_SET_PDEATHSIG``), which Xvfb takes as an orderly shutdown that
+  removes its lock file and socket.
+* Xvfb missing: :class:`~conformance.errors.DisplayUnavailable`, with what to install.
+
+Two limits, both of the operating system: the parent-death signal is Linux-only, and it fires when
+the *thread* that started Xvfb ends, so it is asked for only when the main thread starts the
+server (a server started from another thread is stopped at exit and on ``SIGTERM`` alone); and a
+signal handler can only be installed from the main thread, and only over the default disposition
+(a process that handles ``SIGTERM`` itself keeps its handler and decides).
 
 VTK opens its own X connection with ``XOpenDisplay`` and calls ``abort()`` when that fails ("bad X
 server connection"). While several processes started rendering at once, that happened to about 1 run
@@ -17,15 +33,36 @@ import ctypes
 import ctypes.util
 import functools
 import os
+import select
 import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import threading
 import time
+from dataclasses import dataclass
 
 from conformance.errors import DisplayUnavailable
 
-__all__ = ["close_x_connection", "ensure_display", "on_stop", "stop_display", "virtual_display", "x_connection"]
+__all__ = [
+    "SCREEN",
+    "child_environment",
+    "close_x_connection",
+    "dies_with_this_process",
+    "ensure_display",
+    "on_stop",
+    "server_pid",
+    "stop_display",
+    "virtual_display",
+    "x_connection",
+]
 
-_started = None  # the pyvirtualdisplay.Display this process started, if any
-_on_stop = []  # callbacks that let go of X resources before the display goes away
+#: The virtual screen: big enough for every picture the kit takes, 24-bit colour as the goldens were made.
+SCREEN = "1280x1024x24"
+#: How long Xvfb may take to say it is ready, and to stop when asked.
+START_TIMEOUT = 30.0
+STOP_TIMEOUT = 5.0
 
 #: Attempts, and the first pause between them (doubled each time), when opening an X connection.
 CONNECT_ATTEMPTS = 8
@@ -36,27 +73,64 @@ INSTALL_HINT = (
     "or set DISPLAY to an X server you already have"
 )
 
+_PR_SET_PDEATHSIG = 1  # from <linux/prctl.h>
+
+
+@dataclass
+class _Server:
+    """An Xvfb this process started: the process, the ``DISPLAY`` it serves, the one it replaced."""
+
+    process: subprocess.Popen
+    name: str
+    previous: str | None
+    owner: int  # the pid that started it: a forked child inherits this object but does not own the server
+    handler_installed: bool = False
+
+
+_started: _Server | None = None
+_on_stop = []  # callbacks that let go of X resources before the display goes away
+_atexit_registered = False
+
 
 def ensure_display() -> str:
     """Return the X display to render on, starting Xvfb if ``DISPLAY`` is unset."""
-    global _started
+    global _started, _atexit_registered
     if os.environ.get("DISPLAY"):
         return os.environ["DISPLAY"]
-    if shutil.which("Xvfb") is None:
+    if _started is not None and _started.owner == os.getpid() and _started.process.poll() is None:
+        # DISPLAY was unset behind the kit's back: go on using the server it runs, not a second one
+        os.environ["DISPLAY"] = _started.name
+        return _started.name
+    executable = shutil.which("Xvfb")
+    if executable is None:
         raise DisplayUnavailable(
             "Off-screen rendering needs an X server: DISPLAY is not set and the virtual X server "
             f"Xvfb is not on PATH; {INSTALL_HINT}."
         )
-    from pyvirtualdisplay import Display
+    previous = os.environ.get("DISPLAY")  # set but empty counts as unset, and is put back as it was
+    process, name = _start_xvfb(executable)
+    _started = _Server(process=process, name=name, previous=previous, owner=os.getpid())
+    os.environ["DISPLAY"] = name
+    _started.handler_installed = _install_sigterm_handler()
+    if not _atexit_registered:
+        atexit.register(stop_display)
+        _atexit_registered = True
+    return name
 
-    display = Display(visible=False, size=(1280, 1024), color_depth=24)
-    try:
-        display.start()
-    except Exception as exc:  # pyvirtualdisplay raises several unrelated types
-        raise DisplayUnavailable(f"Xvfb is installed but did not start ({type(exc).__name__}: {exc}); {INSTALL_HINT}.") from exc
-    _started = display
-    atexit.register(stop_display)
-    return os.environ["DISPLAY"]
+
+def server_pid() -> int | None:
+    """The pid of the Xvfb this process started and still runs, else ``None`` (for tests and logs)."""
+    return _started.process.pid if _started is not None and _started.owner == os.getpid() else None
+
+
+def child_environment(environ=None) -> dict[str, str]:
+    """An environment for a child process of the kit's (a pytest run): this one without ``DISPLAY``
+    when that is the Xvfb this process started, which may stop before the child is done (a test that
+    restarts the display, this process ending); the child then starts its own."""
+    env = dict(os.environ if environ is None else environ)
+    if server_pid() is not None and env.get("DISPLAY") == _started.name:
+        env.pop("DISPLAY")
+    return env
 
 
 def on_stop(callback) -> None:
@@ -70,10 +144,162 @@ def stop_display() -> None:
     global _started
     while _on_stop:
         _on_stop.pop()()
-    if _started is not None:
-        display, _started = _started, None
-        display.stop()
+    if _started is None:
+        return
+    server, _started = _started, None
+    if server.owner != os.getpid():  # a forked child: the server is its parent's to stop
+        return
+    if server.handler_installed:
+        _restore_sigterm_handler()
+    _terminate(server.process)
+    if os.environ.get("DISPLAY") == server.name:
+        if server.previous is None:
+            os.environ.pop("DISPLAY", None)
+        else:
+            os.environ["DISPLAY"] = server.previous
 
+
+# -- starting and stopping Xvfb ---------------------------------------------------------------------
+
+def _start_xvfb(executable: str) -> tuple[subprocess.Popen, str]:
+    """Start Xvfb on a display number it picks itself (``-displayfd``: no race with other servers
+    for a number) and return it once it accepts connections, which is when it writes the number."""
+    read_end, write_end = os.pipe()
+    # Xvfb writes warnings for its whole life: a file, not a pipe nobody drains, so it never blocks.
+    log = tempfile.TemporaryFile()
+    command = [executable, "-displayfd", str(write_end), "-screen", "0", SCREEN, "-nolisten", "tcp"]
+    try:
+        try:
+            process = subprocess.Popen(command, stdin=subprocess.DEVNULL, stdout=log, stderr=log,
+                                       pass_fds=(write_end,), preexec_fn=dies_with_this_process(),
+                                       # its own session: a Ctrl-C or hang-up of the terminal goes to the
+                                       # kit, which stops the server once it is done with it
+                                       start_new_session=True)
+        except OSError as exc:
+            raise DisplayUnavailable(f"Xvfb is on PATH ({executable}) but could not be run ({exc.strerror}); "
+                                     f"{INSTALL_HINT}.") from None
+        os.close(write_end)
+        write_end = -1
+        number = _read_display_number(read_end)
+    finally:
+        os.close(read_end)
+        if write_end >= 0:
+            os.close(write_end)
+    if number is None:
+        _terminate(process)
+        log.seek(0)
+        said = _what_went_wrong(log.read().decode("utf-8", "replace"))
+        log.close()
+        raise DisplayUnavailable(
+            f"Xvfb is installed but did not start (exit status {process.returncode}; it said: {said or 'nothing'}); "
+            f"{INSTALL_HINT}."
+        )
+    log.close()  # Xvfb keeps its own descriptor; the file disappears when it exits
+    return process, f":{number}"
+
+
+def _what_went_wrong(output: str) -> str:
+    """Xvfb's error lines (it marks them ``(EE)``), else its last lines: not its usage text."""
+    lines = [line.strip() for line in output.splitlines() if line.strip()]
+    errors = [line.removeprefix("(EE)").strip() for line in lines if line.startswith("(EE)")]
+    return " ".join(line for line in errors if line)[-600:] if any(errors) else " ".join(lines[-3:])[-600:]
+
+
+def _read_display_number(fd: int) -> int | None:
+    """The number Xvfb writes to ``-displayfd`` when it is ready; ``None`` if it exits or takes too long."""
+    data, deadline = b"", time.monotonic() + START_TIMEOUT
+    while not data.endswith(b"\n"):
+        remaining = deadline - time.monotonic()
+        if remaining <= 0 or not select.select([fd], [], [], remaining)[0]:
+            return None
+        chunk = os.read(fd, 32)
+        if not chunk:  # Xvfb exited (it holds the only other write end)
+            return None
+        data += chunk
+    try:
+        return int(data.strip())
+    except ValueError:
+        return None
+
+
+def _terminate(process: subprocess.Popen) -> None:
+    """``SIGTERM`` (Xvfb then removes its lock file and socket), ``SIGKILL`` if it lingers; reaped."""
+    if process.poll() is None:
+        process.terminate()
+        try:
+            process.wait(STOP_TIMEOUT)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.wait()
+
+
+@functools.cache
+def _prctl():
+    """libc's ``prctl`` on Linux, else ``None``."""
+    if not sys.platform.startswith("linux"):
+        return None
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        return libc.prctl
+    except (OSError, AttributeError):
+        return None
+
+
+def dies_with_this_process(*, waited_for: bool = False):
+    """A ``preexec_fn`` for ``subprocess.Popen`` that makes the kernel send the child ``SIGTERM`` when
+    this process dies, however it dies; ``None`` where that cannot be had (not Linux; not the main
+    thread, whose end would fire it early, unless ``waited_for``: the calling thread waits for the
+    child, as ``subprocess.run`` does, so it cannot end first). The kit's Xvfb, the pytest run of
+    ``python -m conformance run`` and the runs of ``verdicts``/``kill-rate`` are started with it."""
+    prctl = _prctl()  # looked up here, in the parent: the child between fork and exec only calls it
+    if prctl is None or (threading.current_thread() is not threading.main_thread() and not waited_for):
+        return None
+    parent = os.getpid()
+
+    def set_death_signal() -> None:
+        prctl(_PR_SET_PDEATHSIG, signal.SIGTERM, 0, 0, 0)
+        if os.getppid() != parent:  # the parent died before prctl: the signal will never come
+            os._exit(1)
+
+    return set_death_signal
+
+
+# -- SIGTERM -------------------------------------------------------------------------------------
+
+def _on_sigterm(signum, frame) -> None:
+    """Stop the display, then die of ``SIGTERM`` as the default disposition would have. No callbacks
+    and no unwinding: the process is going away, and code run after the server is gone would only
+    make Xlib abort on a dead connection."""
+    server = _started
+    if server is not None and server.owner == os.getpid():
+        _terminate(server.process)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    os.kill(os.getpid(), signal.SIGTERM)
+
+
+def _install_sigterm_handler() -> bool:
+    """Install :func:`_on_sigterm` if this is the main thread and ``SIGTERM`` has its default
+    disposition; say whether it was installed."""
+    if threading.current_thread() is not threading.main_thread():
+        return False
+    try:
+        if signal.getsignal(signal.SIGTERM) is not signal.SIG_DFL:
+            return False
+        signal.signal(signal.SIGTERM, _on_sigterm)
+    except (ValueError, OSError):  # e.g. an interpreter that is not the main one
+        return False
+    return True
+
+
+def _restore_sigterm_handler() -> None:
+    try:
+        if signal.getsignal(signal.SIGTERM) is _on_sigterm:
+            signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    except ValueError:  # not the main thread: the handler stays, and does nothing without a server
+        pass
+
+
+# -- X connections -------------------------------------------------------------------------------
 
 @functools.cache  # loaded once: opening and closing a connection both need it
 def _xlib():

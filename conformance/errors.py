@@ -8,6 +8,7 @@ value that was wrong, and what to do about it.
 from __future__ import annotations
 
 __all__ = [
+    "BadArgument",
     "ConformanceError",
     "DisplayUnavailable",
     "GoldenError",
@@ -29,6 +30,12 @@ class ConformanceError(Exception):
 
 class InvalidArgument(ConformanceError, ValueError):
     """A parameter given to the kit (a scene size, a step count, an option) is out of range."""
+
+
+class BadArgument(InvalidArgument):
+    """An option, ini value, environment variable or command-line argument was refused (see
+    :mod:`conformance.validation`); the message names it, its value and type, and what it should be.
+    The pytest plugin turns it into a usage error, the command line into ``error:`` and exit status 2."""
 
 
 class SceneError(ConformanceError):

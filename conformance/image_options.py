@@ -1,9 +1,10 @@
-"""The image checks' options, validated in one place, and what the checks need from them.
+"""The image checks' options, and what the checks need from them.
 
 Each option has an ini twin (command line first): ``--conformance-golden-dir``, ``--conformance-image-tolerance``,
 ``--conformance-results``, ``--conformance-keep-passing``, and ``--regen-golden``. :func:`from_config`
-reads them once per session and refuses bad values with a ``pytest.UsageError`` that names the
-option, the value and what it should be.
+reads them once per session. It is also where the whole plugin's options are checked, once, when
+pytest is configured: the rules live in :mod:`conformance.validation`, and a refused value becomes a
+``pytest.UsageError`` naming the option, the value and what it should be.
 """
 
 from __future__ import annotations
@@ -14,10 +15,10 @@ from typing import Any
 
 import pytest
 
+from conformance.validation import DEFAULT_RESULTS
+
 __all__ = ["Pictures", "add_options", "from_config"]
 
-TOLERANCE_CHOICES = ("auto", "same-renderer", "other-renderer")
-DEFAULT_RESULTS = "conformance-results"
 _KEY = pytest.StashKey["Pictures"]()
 _REGENERATED = "conformance_golden_regenerated"
 
@@ -41,18 +42,13 @@ def add_options(group, parser) -> None:
                     "prints what changed. Goldens are never written without this")
 
 
-def _value(config, name: str):
-    value = config.getoption(f"conformance_{name}")
-    return value if value is not None else config.getini(f"conformance_{name}")
-
-
 @dataclass
 class Pictures:
     """What the image checks need from the session: where goldens are, which tolerance set, where
     to put pictures, whether to regenerate."""
 
     golden_dir: Path
-    tolerance: str  # one of TOLERANCE_CHOICES
+    tolerance: str  # one of conformance.validation.IMAGE_TOLERANCE_CHOICES
     results: Path
     keep_passing: bool
     regen: bool
@@ -137,25 +133,19 @@ def _default_golden_dir() -> Path:
 
 
 def from_config(config) -> Pictures:
-    """The session's :class:`Pictures`, read and validated once."""
+    """The session's :class:`Pictures`, read and validated once (with every other option of the plugin)."""
     cached = config.stash.get(_KEY, None)
     if cached is not None:
         return cached
-    tolerance = _value(config, "image_tolerance") or "auto"
-    if tolerance not in TOLERANCE_CHOICES:
-        raise pytest.UsageError(f"conformance_image_tolerance={tolerance!r} ({type(tolerance).__name__}), "
-                                f"but should be one of {', '.join(TOLERANCE_CHOICES)}")
-    golden_dir = _value(config, "golden_dir")
-    golden_dir = Path(golden_dir).expanduser().resolve() if golden_dir else _default_golden_dir()
-    if not golden_dir.is_dir() and not config.getoption("conformance_regen_golden"):
-        raise pytest.UsageError(f"conformance_golden_dir={str(golden_dir)!r} is not a directory; give an existing "
-                                "directory of goldens, or add --regen-golden to make them there")
-    results = Path(_value(config, "results") or DEFAULT_RESULTS).expanduser()
-    if results.exists() and not results.is_dir():
-        raise pytest.UsageError(f"conformance_results={str(results)!r} is a file, but should be a directory "
-                                "(it receives failure pictures and report.html)")
-    keep = _value(config, "keep_passing")
-    pictures = Pictures(golden_dir=golden_dir, tolerance=tolerance, results=results.resolve(),
-                        keep_passing=bool(keep), regen=bool(config.getoption("conformance_regen_golden")))
+    from conformance import validation
+    from conformance.errors import BadArgument
+
+    try:
+        options = validation.plugin_options(config)
+    except BadArgument as err:
+        raise pytest.UsageError(str(err)) from None
+    golden_dir = options.golden_dir.resolve() if options.golden_dir is not None else _default_golden_dir()
+    pictures = Pictures(golden_dir=golden_dir, tolerance=options.image_tolerance, results=options.results.resolve(),
+                        keep_passing=options.keep_passing, regen=options.regen)
     config.stash[_KEY] = pictures
     return pictures

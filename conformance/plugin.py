@@ -34,6 +34,8 @@ SYNC_OPTION = "--sync"
 _SYNC_KEY = pytest.StashKey["object"]()
 _VERDICT_KEY = pytest.StashKey[dict]()
 _RECORDS_KEY = pytest.StashKey[list]()
+#: The name under which each check's record rides on its report (``report.user_properties``).
+_RECORD_PROPERTY = "conformance_record"
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:
@@ -48,15 +50,25 @@ def pytest_addoption(parser: pytest.Parser) -> None:
     )
     parser.addini("conformance_sync", "default for --sync", default=None)
     for name, help_text in _TOLERANCE_OPTIONS.items():
-        group.addoption(f"--conformance-{name.replace('_', '-')}", dest=f"conformance_{name}", type=float,
+        # No type=float: conformance.validation reads the text, so a bad number, NaN or inf is refused
+        # with the same sentence as in the ini file.
+        group.addoption(f"--conformance-{name.replace('_', '-')}", dest=f"conformance_{name}",
                         default=None, metavar="X", help=help_text)
         parser.addini(f"conformance_{name}", help_text, default=None)
     group.addoption("--conformance-report", dest="conformance_report", metavar="PATH", default=None,
                     help="write each check's outcome, scene and worst error as JSON to PATH")
     parser.addini("conformance_report", "default for --conformance-report", default=None)
+    group.addoption("--conformance-survey", dest="conformance_survey", action="store_true", default=None,
+                    help="survey mode: a check notes every failure and runs every frame, then fails with the first "
+                    "failure and every kind that failed with its worst figure (what 'verdicts' uses; default: stop "
+                    "at the first failing frame)")
+    parser.addini("conformance_survey", "default for --conformance-survey", type="bool", default=False)
     from conformance import image_options
 
     image_options.add_options(group, parser)
+    from conformance import selection
+
+    selection.add_options(group)
 
 
 _TOLERANCE_OPTIONS = {
@@ -68,38 +80,50 @@ _TOLERANCE_OPTIONS = {
 
 
 def _option(config: pytest.Config, name: str):
-    value = config.getoption(f"conformance_{name}")
-    return value if value is not None else config.getini(f"conformance_{name}")
+    """Option ``conformance_NAME`` (command line, else ini), checked by :mod:`conformance.validation`;
+    ``None`` when not given. A refused value is a usage error naming the option, value and fix."""
+    from conformance import validation
+    from conformance.errors import BadArgument
+
+    try:
+        return validation.plugin_option(config, name)
+    except BadArgument as err:
+        raise pytest.UsageError(str(err)) from None
 
 
 def tolerance_from(config: pytest.Config):
     from conformance.tolerances import DEFAULT
 
-    values = {}
-    for name in _TOLERANCE_OPTIONS:
-        raw = _option(config, name)
-        if raw in (None, ""):
-            continue
-        try:
-            value = float(raw)
-        except ValueError:
-            raise pytest.UsageError(f"conformance_{name}={raw!r} ({type(raw).__name__}), but should be a number") from None
-        if not value >= 0:
-            raise pytest.UsageError(f"conformance_{name}={raw!r}, but should be a non-negative number")
-        values[name] = value
+    values = {name: value for name in _TOLERANCE_OPTIONS if (value := _option(config, name)) is not None}
     return dataclasses.replace(DEFAULT, **values)
 
 
 def _sync_spec(config: pytest.Config) -> str:
+    from conformance.errors import BadArgument
     from conformance.sync import resolve_spec
 
-    return resolve_spec(config.getoption("conformance_sync") or config.getini("conformance_sync"))
+    try:  # an empty --sync, ini value or $CONFORMANCE_SYNC is refused, never read as "the default"
+        return resolve_spec(config.getoption("conformance_sync"), config.getini("conformance_sync"))
+    except BadArgument as err:
+        raise pytest.UsageError(str(err)) from None
 
 
 def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line("markers", "scene(name): the reference scene a conformance check runs on")
     config.addinivalue_line("markers", "sync: a check that runs the sync implementation under test (added automatically)")
     config.stash[_VERDICT_KEY] = defaultdict(lambda: defaultdict(list))
+    if getattr(config.option, "dist", "no") == "load":
+        # -n's default scheduling, with groups: the checks of one scene (marked below) go to one
+        # worker, which steps the scene once for all of them (conformance.shared_run).
+        config.option.dist = "loadgroup"
+    config.pluginmanager.register(_Records(config), "conformance-records")
+    import os
+
+    from conformance import selection
+    from conformance.sync import ENV_VAR
+
+    named = bool(config.getoption("conformance_sync") or config.getini("conformance_sync") or ENV_VAR in os.environ)
+    config.pluginmanager.register(selection.Selection(config, sync_named=named), "conformance-selection")
     if not hasattr(config, "workerinput"):
         from conformance import image_options
 
@@ -133,9 +157,16 @@ def pytest_report_header(config: pytest.Config) -> list[str]:
 def pytest_collection_modifyitems(session: pytest.Session, config: pytest.Config, items) -> None:
     """Mark the checks that run the sync under test (``-m sync`` selects them) and load the sync once,
     before any check runs, if any collected check needs it."""
+    from conformance import ordering
+
     uses_sync = [item for item in items if "sync_implementation" in getattr(item, "fixturenames", ())]
     for item in uses_sync:
         item.add_marker(pytest.mark.sync)
+    ordering.fail_fast(items, lambda item: "sync_implementation" in getattr(item, "fixturenames", ()))
+    for item in uses_sync:  # under pytest-xdist a scene's checks share its run on one worker (shared_run)
+        marker = item.get_closest_marker("scene")
+        if marker is not None:
+            item.add_marker(pytest.mark.xdist_group(marker.args[0]))
     if not uses_sync:
         return
     from conformance.errors import SyncError
@@ -179,44 +210,65 @@ def kit(request: pytest.FixtureRequest, sync_implementation):
 @pytest.hookimpl(wrapper=True)
 def pytest_runtest_makereport(item: pytest.Item, call):
     report = yield
-    marker = item.get_closest_marker("scene")
-    if marker is not None and (report.when == "call" or report.outcome != "passed"):
-        item.config.stash[_VERDICT_KEY][marker.args[0]][report.outcome].append(item.name)
-    if report.when == "call" or report.outcome != "passed":
-        from conformance.pytest_helpers import WORST
+    from conformance import survey
 
+    survey.settle(item, report)  # survey mode: a check that noted failures fails now, naming every kind
+    if report.when == "call" or report.outcome != "passed":
+        marker = item.get_closest_marker("scene")
         message = ""
         if report.failed and report.longrepr is not None:
             message = str(getattr(report.longrepr, "reprcrash", None) and report.longrepr.reprcrash.message or report.longrepr)
-        item.config.stash.setdefault(_RECORDS_KEY, []).append({
+        # On the report, not in this process: under pytest-xdist the report travels to the controller,
+        # which is the one process that prints the verdicts and writes the JSON.
+        report.user_properties.append((_RECORD_PROPERTY, {
             "nodeid": report.nodeid,
             "check": getattr(item, "originalname", item.name),
             "scene": marker.args[0] if marker is not None else None,
             "when": report.when,
             "outcome": "xfailed" if hasattr(report, "wasxfail") and report.skipped else report.outcome,
-            "worst": item.stash.get(WORST, None),
+            "verdict": report.outcome,
+            "worst": item.stash.get(survey.WORST, None),
+            "kinds": survey.kinds_of(item, report, message),
             "message": message.strip().splitlines()[0][:4000] if message.strip() else "",
-        })
+        }))
     return report
 
 
-def pytest_sessionfinish(session: pytest.Session, exitstatus) -> None:
-    if not hasattr(session.config, "workerinput"):  # under xdist, only the controller writes the page
-        from conformance import image_options
+class _Records:
+    """Collects the records that ride on reports, in the process that writes them out (pytest's own,
+    or the pytest-xdist controller): registered per session, so nested sessions (pytester) keep theirs."""
 
-        image_options.from_config(session.config).write_report(_sync_spec(session.config))
+    def __init__(self, config: pytest.Config):
+        self.config = config
+
+    def pytest_runtest_logreport(self, report: pytest.TestReport) -> None:
+        if hasattr(self.config, "workerinput"):
+            return
+        for name, record in report.user_properties:
+            if name == _RECORD_PROPERTY:
+                record = dict(record)
+                verdict = record.pop("verdict")
+                self.config.stash.setdefault(_RECORDS_KEY, []).append(record)
+                if record["scene"] is not None:
+                    self.config.stash[_VERDICT_KEY][record["scene"]][verdict].append(record["nodeid"])
+
+
+def pytest_sessionfinish(session: pytest.Session, exitstatus) -> None:
+    if hasattr(session.config, "workerinput"):  # under xdist, only the controller writes the page and the JSON
+        return
+    from conformance import image_options
+
+    image_options.from_config(session.config).write_report(_sync_spec(session.config))
     path = _option(session.config, "report")
     if not path:
         return
     import json
-    import os
+
+    from conformance.files import write_atomically
 
     records = session.config.stash.get(_RECORDS_KEY, [])
     payload = {"sync": _sync_spec(session.config), "exitstatus": int(exitstatus), "records": records}
-    tmp = f"{path}.tmp"
-    with open(tmp, "w", encoding="utf-8") as fh:
-        json.dump(payload, fh, indent=1, default=float)
-    os.replace(tmp, path)  # never a half-written report
+    write_atomically(path, json.dumps(payload, indent=1, default=float).encode("utf-8"))  # never half a report
 
 
 def pytest_terminal_summary(terminalreporter, exitstatus, config: pytest.Config) -> None:

@@ -3,6 +3,10 @@ helpers with readable messages.
 
 Messages follow array-api-tests: ``x=…, but should be … [scene(params), frame]``, followed by a
 command that reproduces the failure.
+
+Two modes (:mod:`conformance.survey`): by default an assertion fails the check at its first failing
+frame; in survey mode (``--conformance-survey``) :class:`Kit` notes each failure by kind, with the
+same message, and the check runs on and fails at its end with every kind it found.
 """
 
 from __future__ import annotations
@@ -10,24 +14,25 @@ from __future__ import annotations
 import contextlib
 import json
 import shlex
+import weakref
 from typing import Any, Iterable, Iterator, Mapping, Sequence
 
 import pytest
 
-from conformance import compare, events as events_module, scenes
+from conformance import compare, events as events_module, scenes, survey as survey_module
 from conformance.errors import SyncError
+from conformance.survey import WORST  # noqa: F401  (where the plugin and older callers find it)
 from conformance.tolerances import Tolerance
 
 __all__ = [
     "Kit",
     "assert_geometry_matches",
     "assert_vertices_match",
+    "bounds_figure",
     "each_scene",
     "reproduce_command",
     "sync_run",
 ]
-
-WORST = pytest.StashKey[dict]()
 
 
 def each_scene(argname: str = "scene_name", origin: str | None = None, only: Sequence[str] | None = None):
@@ -72,19 +77,41 @@ def _context(run: Any, sync: str, frame: int) -> str:
     return text + "]"
 
 
-def assert_vertices_match(results: Iterable[Any], *, run: Any, sync: str) -> None:
-    """Every target is drawn where pybullet says it is, within tolerance."""
-    __tracebackhide__ = True
-    failures = [r for r in results if not r.ok]
-    if not failures:
-        return
-    worst = max(failures, key=lambda r: (r.error != r.error, r.error))  # NaN first, then largest
+def _by_ratio(r: Any) -> tuple[bool, float]:
+    """Sort key of vertex results: NaN first, then the largest error in tolerances."""
+    return (r.error != r.error, r.error / r.tolerance if r.tolerance else r.error)
+
+
+def _vertices_message(failures: Sequence[Any], run: Any, sync: str, worst: Any = None) -> str:
+    """The message of a frame's vertex failures, about ``worst`` (default: the largest error, NaN first)."""
+    if worst is None:
+        worst = max(failures, key=lambda r: (r.error != r.error, r.error))  # NaN first, then largest
     lines = [f"{worst.describe()} {_context(run, sync, worst.frame)}"]
     if len(failures) > 1:
         others = ", ".join(sorted({r.target for r in failures} - {worst.target}))
         lines.append(f"{len(failures)} targets out of tolerance at this frame" + (f" (also: {others[:300]})" if others else ""))
     lines.append("reproduce: " + reproduce_command(run.scene.name, sync, worst.frame, run.params, run.events))
-    pytest.fail("\n".join(lines), pytrace=False)
+    return "\n".join(lines)
+
+
+def _normals_message(failures: Sequence[Any], run: Any, sync: str) -> str:
+    worst = max(failures, key=lambda r: r.angle)
+    return (f"{worst.describe()} {_context(run, sync, worst.frame)}\nreproduce: "
+            + reproduce_command(run.scene.name, sync, worst.frame, run.params, run.events))
+
+
+def _unannounced_message(frame: int, actor: str, run: Any, sync: str) -> str:
+    return (f"actor {actor!r}: the sync changed its vertex data at frame {frame} without marking it modified "
+            "(no Modified()/utils.update_actor), so a live VTK window keeps drawing the old vertices "
+            f"{_context(run, sync, frame)}")
+
+
+def assert_vertices_match(results: Iterable[Any], *, run: Any, sync: str) -> None:
+    """Every target is drawn where pybullet says it is, within tolerance."""
+    __tracebackhide__ = True
+    failures = [r for r in results if not r.ok]
+    if failures:
+        pytest.fail(_vertices_message(failures, run, sync), pytrace=False)
 
 
 def assert_normals_turn(results: Iterable[Any], *, run: Any, sync: str) -> None:
@@ -92,9 +119,7 @@ def assert_normals_turn(results: Iterable[Any], *, run: Any, sync: str) -> None:
     __tracebackhide__ = True
     failures = [r for r in results if not r.ok]
     if failures:
-        worst = max(failures, key=lambda r: r.angle)
-        pytest.fail(f"{worst.describe()} {_context(run, sync, worst.frame)}\nreproduce: "
-                    + reproduce_command(run.scene.name, sync, worst.frame, run.params, run.events), pytrace=False)
+        pytest.fail(_normals_message(failures, run, sync), pytrace=False)
 
 
 def assert_changes_announced(run: Any, *, sync: str) -> None:
@@ -103,10 +128,7 @@ def assert_changes_announced(run: Any, *, sync: str) -> None:
     __tracebackhide__ = True
     if run.unannounced:
         frame, actor = run.unannounced[0]
-        pytest.fail(
-            f"actor {actor!r}: the sync changed its vertex data at frame {frame} without marking it modified "
-            "(no Modified()/utils.update_actor), so a live VTK window keeps drawing the old vertices "
-            f"{_context(run, sync, frame)}", pytrace=False)
+        pytest.fail(_unannounced_message(frame, actor, run, sync), pytrace=False)
 
 
 def assert_geometry_matches(results: Iterable[Any], *, scene: str, params: Mapping[str, Any], frame: int) -> None:
@@ -123,13 +145,30 @@ def assert_geometry_matches(results: Iterable[Any], *, scene: str, params: Mappi
 
 
 class Kit:
-    """What a check needs about the run it is part of: the sync under test, the tolerances, and a
-    place to record the worst error it saw (for the verdict table). Provided as the ``kit`` fixture."""
+    """What a check needs about the run it is part of: the sync under test, the tolerances, a place
+    to record the worst error it saw (for the verdict table), and the mode. Provided as the ``kit``
+    fixture.
 
-    def __init__(self, implementation, tolerance: Tolerance, node: pytest.Item | None = None):
+    Default mode: :meth:`assert_frame` and :meth:`fail` raise at the first failure, with the messages
+    the ``assert_*`` helpers give. Survey mode (``survey=True``, or ``--conformance-survey`` for the
+    fixture): they note each failure in :attr:`survey` by kind and return, so the check runs every
+    frame it would have run; the plugin fails the check at its end (:func:`conformance.survey.settle`),
+    or call :meth:`finish`."""
+
+    def __init__(self, implementation, tolerance: Tolerance, node: pytest.Item | None = None,
+                 survey: bool | None = None):
         self.implementation = implementation
         self.tolerance = tolerance
         self._node = node
+        if survey is None:
+            survey = node is not None and survey_module.enabled(node.config)
+        #: Survey mode's findings (shared by every Kit of one check); None in default mode.
+        self.survey: survey_module.Survey | None = None
+        if survey:
+            self.survey = survey_module.Survey() if node is None else node.stash.setdefault(
+                survey_module.SURVEY, survey_module.Survey())
+        # run -> how many of its unannounced changes are noted; weak, so a later run never inherits a count
+        self._announced: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
     @property
     def sync(self) -> str:
@@ -141,7 +180,7 @@ class Kit:
     def _record(self, results: Sequence[Any]) -> None:
         if self._node is None or not results:
             return
-        worst = max(results, key=lambda r: (r.error != r.error, r.error / r.tolerance if r.tolerance else r.error))
+        worst = max(results, key=_by_ratio)
         ratio = worst.error / worst.tolerance if worst.tolerance else worst.error
         best = self._node.stash.get(WORST, None)
         if best is None or not (best["ratio"] >= ratio):  # NaN ratios win
@@ -150,10 +189,64 @@ class Kit:
 
     def assert_frame(self, run: Any) -> None:
         """What is drawn now is right: vertices where pybullet says, normals turned with them, and
-        every change announced to VTK."""
+        every change announced to VTK. Survey mode checks all three and notes what failed."""
         __tracebackhide__ = True
         results = compare.compare_vertices(run.drawing, run.frame, self.tolerance)
         self._record(results)
-        assert_vertices_match(results, run=run, sync=self.sync)
-        assert_normals_turn(compare.compare_normals(run.drawing, run.frame, self.tolerance), run=run, sync=self.sync)
-        assert_changes_announced(run, sync=self.sync)
+        sync = self.sync
+        # The same order and messages as assert_vertices_match, assert_normals_turn and
+        # assert_changes_announced: default mode raises the first of them, survey mode notes each.
+        failures = [r for r in results if not r.ok]
+        if failures:
+            worst = max(failures, key=_by_ratio)
+            # The figure is the worst in tolerances, and so is its message; the first failure's message
+            # stays default mode's own (about the largest error in metres).
+            self._failed("vertices", lambda w=worst: _vertices_message(failures, run, sync, w),
+                         first=lambda: _vertices_message(failures, run, sync), value=worst.error,
+                         limit=worst.tolerance, unit="m", frame=worst.frame, target=worst.target)
+        turned = [r for r in compare.compare_normals(run.drawing, run.frame, self.tolerance) if not r.ok]
+        if turned:
+            worst = max(turned, key=lambda r: (r.angle / r.tolerance if r.tolerance else r.angle))
+            self._failed("normals", lambda: _normals_message(turned, run, sync), value=worst.angle,
+                         limit=worst.tolerance, unit="rad", frame=worst.frame, target=worst.target)
+        seen = self._announced.get(run, 0)
+        for frame, actor in run.unannounced[seen:]:
+            self._failed("Modified", lambda: _unannounced_message(frame, actor, run, sync), frame=frame, target=actor)
+        self._announced[run] = len(run.unannounced)
+
+    def fail(self, kind: str, message: str, *, exception: type[BaseException] | None = None, **numbers: Any) -> None:
+        """A failure of ``kind`` (:data:`conformance.survey.KINDS`) that a check found: raised now in
+        default mode (``pytest.fail(message)``, or ``exception(message)`` for a check that has always
+        failed with that type), noted in survey mode with ``numbers`` (``value``, ``limit``, ``unit``,
+        ``frame``, ``target``, as :func:`conformance.survey.figure` takes them)."""
+        __tracebackhide__ = True
+        self._failed(kind, message, exception=exception, **numbers)
+
+    def _failed(self, kind: str, message, *, first=None, exception: type[BaseException] | None = None,
+                **numbers: Any) -> None:
+        """:meth:`fail` with ``message`` a string or a callable that makes it (called only when needed);
+        ``first``, if given, is default mode's message, raised there and kept as a survey's first."""
+        __tracebackhide__ = True
+        if self.survey is not None:
+            self.survey.note(kind, message, first=first, **numbers)
+            return
+        text = (first or message)() if callable(first or message) else (first or message)
+        if self._node is not None:  # the plugin's record names the kind and figure of what was raised
+            self._node.stash[survey_module.RAISED] = {kind: survey_module.figure(**numbers, message=text)}
+        if exception is not None:
+            raise exception(text)
+        pytest.fail(text, pytrace=False)
+
+    def finish(self) -> None:
+        """Survey mode: fail now if anything was noted, with the first failure and every kind (what
+        the plugin does at the end of a check). Nothing in default mode."""
+        __tracebackhide__ = True
+        if self.survey is not None and self.survey.kinds:
+            pytest.fail(self.survey.failure_text(), pytrace=False)
+
+
+def bounds_figure(problems: Sequence[str]) -> dict[str, Any]:
+    """The worst of a target's bounds problems as figure numbers (value, limit, unit), read from the
+    problems :func:`conformance.compare.compare_bounds` states."""
+    fig = survey_module.figure_from_message("bounds", "; ".join(problems))
+    return {"value": fig["value"], "limit": fig["limit"], "unit": fig["unit"]}

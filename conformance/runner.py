@@ -38,6 +38,7 @@ class Run:
         self.built_mesh = {name: backends.mesh_signature(a) for name, a in self.drawing.actors.items()}
         #: (frame, actor name) of every sync that changed an actor's data without telling VTK.
         self.unannounced: list[tuple[int, str]] = []
+        self._after: dict[str, tuple[int, bytes]] = {}
 
     def step(self) -> None:
         """One frame of physics without syncing: events, actions, ``stepSimulation``."""
@@ -49,11 +50,17 @@ class Run:
     def sync(self) -> None:
         """Call the sync under test for the current frame, noting changes VTK was not told about: a
         live renderer re-uploads geometry only when the data's modification time moves."""
-        before = {name: backends.content_state(a) for name, a in self.drawing.actors.items()}
+        actors = self.drawing.actors
+        # What an actor held after the last sync is what it holds now unless its time moved since
+        # (a render swaps colours, say), so each frame copies every actor's data once, not twice.
+        before = {}
+        for name, actor in actors.items():
+            last = self._after.get(name)
+            before[name] = last if last is not None and last[0] == backends.content_time(actor) else backends.content_state(actor)
         self.syncer(self.frame)
-        for name, a in self.drawing.actors.items():
-            mtime, digest = backends.content_state(a)
-            if digest != before[name][1] and mtime <= before[name][0]:
+        self._after = {name: backends.content_state(a) for name, a in actors.items()}
+        for name, (mtime, content) in self._after.items():
+            if content != before[name][1] and mtime <= before[name][0]:
                 self.unannounced.append((self.frame, name))
 
     def advance(self, frames: int = 1) -> None:

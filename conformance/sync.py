@@ -44,9 +44,14 @@ SHORT_NAMES = {
 }
 
 
-def resolve_spec(option: str | None) -> str:
-    """The spec in force: the ``--sync`` option, else ``$CONFORMANCE_SYNC``, else ``reference``."""
-    return option or os.environ.get(ENV_VAR) or DEFAULT
+def resolve_spec(option: str | None, ini: str | None = None) -> str:
+    """The spec in force: the ``--sync`` option, else the ini ``conformance_sync``, else
+    ``$CONFORMANCE_SYNC``, else ``reference``. ``None`` is "not given"; a value given empty, the
+    variable set to nothing included, raises :class:`~conformance.errors.BadArgument` rather than
+    quietly running the default (see :func:`conformance.validation.resolve_sync`)."""
+    from conformance.validation import resolve_sync
+
+    return resolve_sync(option, ini)
 
 
 def _exception_line(exc: BaseException) -> str:

@@ -72,7 +72,7 @@ def verify_free_fall(params, dt: float, count: int, steps: int = 60, *, assumed_
             z, vz = free_fall(start.position[2], G, assumed_dt, step + 1, assumed_substeps)
             where = context("free_fall", params, f"step {step + 1}",
                             f"setTimeStep({dt:.6g}), numSubSteps={count}")
-            assert_close("vz", actual=state.linear[2], expected=vz, where=where, law="g·dt·n", **EXACT)
+            assert_close("vz", actual=state.linear[2], expected=vz, where=where, law="g·h·m (h = dt/k, m sub-steps taken)", **EXACT)
             assert_close("z", actual=state.position[2], expected=z, where=where,
                          law="z0 + g·(dt/k)²·m(m+1)/2, m = n·k", **EXACT)
             assert_vector_close("(x, y)", actual=state.position[:2], expected=start.position[:2], where=where,

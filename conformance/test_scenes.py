@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pybullet
 import pytest
-from hypothesis import given, strategies as st
+from hypothesis import given
 
 from conformance import backends, compare, determinism, scenes
 from conformance.errors import InvalidArgument

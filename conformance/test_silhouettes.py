@@ -12,7 +12,7 @@ from __future__ import annotations
 import pytest
 from hypothesis import given, strategies as st
 
-from conformance import backends, scenes, strategies
+from conformance import backends, image_options, scenes, shared_run, strategies
 from conformance.events import Teleport
 from conformance.profiles import check_settings
 from conformance.pytest_helpers import _context, each_scene, reproduce_command
@@ -34,15 +34,21 @@ def silhouette_check(run, sync: str, pictures=None, nodeid: str = ""):
     scene = run.scene
     ids_fury = backends.render_ids(run.drawing, scene.camera, scene.image_size)
     ids_bullet = silhouettes.pybullet_mask(scene, scene.bindings, scene.camera, scene.image_size)
+    record = _record(run, sync, ids_fury, ids_bullet)
+    record.nodeid = nodeid
+    if pictures is not None:
+        pictures.keep(record, silhouettes.mask_images(ids_fury, ids_bullet))
+    return record
+
+
+def _record(run, sync: str, ids_fury, ids_bullet):
+    scene = run.scene
     record = silhouettes.compare_silhouettes(
         ids_fury, ids_bullet, min_iou=silhouettes.thresholds(scene.bindings),
         names=[t.name for t in run.drawing.targets], scene=scene.name, frame=run.frame)
     record.sync = sync
     record.params = golden.jsonable(dict(run.params))
     record.reproduce = reproduce_command(scene.name, sync, run.frame, run.params, run.events)
-    record.nodeid = nodeid
-    if pictures is not None:
-        pictures.keep(record, silhouettes.mask_images(ids_fury, ids_bullet))
     return record
 
 
@@ -52,13 +58,37 @@ def assert_passed(record, run, sync: str) -> None:
         pytest.fail(f"{record.message} {_context(run, sync, run.frame)}\nreproduce: {record.reproduce}", pytrace=False)
 
 
+#: Where the watcher of the golden-frame check leaves its records (and a failure's pictures) for the check.
+_SEEN = "silhouettes at golden frames"
+
+
+@shared_run.watcher("test_silhouettes_match_pybullet_at_golden_frames", last=lambda spec: max(spec.frames_with_goldens()))
+def _silhouettes(run, kit):
+    if run.frame not in scenes.get(run.scene.name).frames_with_goldens():
+        return
+    scene = run.scene
+    ids_fury = backends.render_ids(run.drawing, scene.camera, scene.image_size)
+    ids_bullet = silhouettes.pybullet_mask(scene, scene.bindings, scene.camera, scene.image_size)
+    record = _record(run, kit.sync, ids_fury, ids_bullet)
+    config = kit._node.config  # None outside a pytest session: nothing is kept then but failures
+    keep = not record.passed or (config is not None and image_options.from_config(config).keep_passing)
+    kit._node.stash.setdefault(_SEEN, []).append((record, silhouettes.mask_images(ids_fury, ids_bullet) if keep else {}))
+    if not record.passed:
+        worst = min(record.details["targets"], key=lambda t: t["iou"] - t["min_iou"])
+        kit.fail("silhouette", f"{record.message} {_context(run, kit.sync, run.frame)}\nreproduce: {record.reproduce}",
+                 value=worst["iou"], limit=worst["min_iou"], unit="IoU", at_least=True, frame=run.frame,
+                 target=worst["target"])
+
+
 @each_scene()
 def test_silhouettes_match_pybullet_at_golden_frames(scene_name, kit, pictures, request):
-    """Each target's FURY silhouette overlaps pyBullet's at the first, middle and last golden frame."""
-    with kit.run(scene_name) as run:
-        for frame in scenes.get(scene_name).frames_with_goldens():
-            run.advance(frame - run.frame)
-            assert_passed(silhouette_check(run, kit.sync, pictures, request.node.nodeid), run, kit.sync)
+    """Each target's FURY silhouette overlaps pyBullet's at the first, middle and last golden frame
+    (of the scene's shared run, :mod:`conformance.shared_run`)."""
+    check = "test_silhouettes_match_pybullet_at_golden_frames"
+    for record, images in shared_run.seen(kit, check, scene_name).get(_SEEN, ()):
+        record.nodeid = request.node.nodeid
+        pictures.keep(record, images)
+    shared_run.report(kit, check, scene_name)
 
 
 @each_scene()

@@ -13,10 +13,10 @@ import numpy as np
 import pytest
 from hypothesis import example, given, strategies as st
 
-from conformance import backends, compare, scenes, strategies
+from conformance import backends, compare, scenes, shared_run, strategies
 from conformance.events import JointReset, Teleport
 from conformance.profiles import check_settings
-from conformance.pytest_helpers import _context, each_scene, reproduce_command
+from conformance.pytest_helpers import _context, bounds_figure, each_scene, reproduce_command
 
 
 def _scene_runs(scene_name: str, longest: int):
@@ -79,18 +79,31 @@ def check_every_frame_equals_once(kit, scene_name: str, params: dict, frames: in
             context = _context(run, kit.sync, frames)
     for name in drawn[0]:
         gap = float(np.nan_to_num(np.abs(drawn[0][name] - drawn[1][name]), nan=np.inf).max())
-        assert gap <= tolerance, (
-            f"actor {name!r} is drawn {gap:.3g} m apart when synced every frame and when synced once after "
-            f"{frames} frames, but should agree within {tolerance:.3g} m {context}")
+        if not gap <= tolerance:
+            kit.fail("every frame = once",
+                     f"actor {name!r} is drawn {gap:.3g} m apart when synced every frame and when synced once after "
+                     f"{frames} frames, but should agree within {tolerance:.3g} m {context}",
+                     exception=AssertionError, value=gap, limit=tolerance, unit="m", frame=frames, target=name)
+
+
+#: The frames of the default run the every-frame check looks at (the rest of a long scene is tumbling's).
+EVERY_FRAME = 400
+
+
+@shared_run.watcher("test_vertices_match_poses_every_frame", last=lambda spec: min(spec.steps, EVERY_FRAME))
+def _every_frame(run, kit):
+    kit.assert_frame(run)
 
 
 @each_scene()
 def test_vertices_match_poses_every_frame(scene_name, kit):
     """The scene with its own parameters (the guide's, for the guide's scenes), then with each of its
-    ``examples``: every target, every frame of the default run, from frame 0 (right after set-up) on."""
+    ``examples``: every target, every frame of the default run, from frame 0 (right after set-up) on.
+    (The default run is the scene's shared run, :mod:`conformance.shared_run`.)"""
     spec = scenes.get(scene_name)
-    for params in ({}, *spec.examples):
-        check_run(kit, scene_name, dict(params), min(spec.steps, 400))
+    shared_run.report(kit, "test_vertices_match_poses_every_frame", scene_name)
+    for params in spec.examples:
+        check_run(kit, scene_name, dict(params), min(spec.steps, EVERY_FRAME))
 
 
 @each_scene()
@@ -127,45 +140,52 @@ def test_vertices_match_in_every_orientation(scene_name, kit):
     check()
 
 
+@shared_run.watcher("test_no_drift_over_ten_thousand_frames", last=lambda spec: 10_000, scenes=("tumbling",))
+def _no_drift(run, kit):
+    kit.assert_frame(run)
+
+
 @pytest.mark.scene("tumbling")
 def test_no_drift_over_ten_thousand_frames(kit):
     """Bodies tumbling through every attitude for 10,000 frames (42 s of simulated time), checked
     after every frame: an implementation that accumulates per-frame increments must keep its
     rounding within the same tolerance as one that computes each frame from the pose."""
-    check_run(kit, "tumbling", {}, 10_000)
+    shared_run.report(kit, "test_no_drift_over_ten_thousand_frames", "tumbling")
+
+
+@shared_run.watcher("test_sync_does_not_touch_physics", last=lambda spec: min(spec.steps, 30), physics=True)
+def _physics_untouched(run, kit, before):
+    after = run.scene.physics_state()
+    if before != after:
+        changed = [a.decode() for a, b in zip(before.splitlines(), after.splitlines()) if a != b]
+        kit.fail("physics touched",
+                 f"the sync changed pybullet's state: {changed[0][:300]} … [{run.scene.name}, frame {run.frame}, "
+                 f"sync {kit.sync!r}] ({len(changed)} entries changed)",
+                 value=len(changed), unit="entries changed", frame=run.frame)
 
 
 @each_scene()
 def test_sync_does_not_touch_physics(scene_name, kit):
     """A sync only reads pybullet: every body's pose, velocity, joint states and dynamics and the
-    engine parameters are bit-identical before and after each sync call."""
-    spec = scenes.get(scene_name)
-    with kit.run(scene_name) as run:
-        for _ in range(min(spec.steps, 30)):
-            run.step()
-            before = run.scene.physics_state()
-            run.sync()
-            after = run.scene.physics_state()
-            if before != after:
-                changed = [a.decode() for a, b in zip(before.splitlines(), after.splitlines()) if a != b]
-                pytest.fail(
-                    f"the sync changed pybullet's state: {changed[0][:300]} … [{scene_name}, frame {run.frame}, "
-                    f"sync {kit.sync!r}] ({len(changed)} entries changed)", pytrace=False)
+    engine parameters are bit-identical before and after each sync call (the first 30 frames)."""
+    shared_run.report(kit, "test_sync_does_not_touch_physics", scene_name)
+
+
+@shared_run.watcher("test_sync_keeps_the_mesh", last=lambda spec: min(spec.steps, 30))
+def _mesh_kept(run, kit):
+    for name, actor in run.drawing.actors.items():
+        now = backends.mesh_signature(actor)
+        if now != run.built_mesh[name]:
+            what = [w for w, a, b in zip(("vertex count", "cells", "colours"), now, run.built_mesh[name]) if a != b]
+            kit.fail("mesh", f"actor {name!r}: {', '.join(what)} changed, but a sync should only move vertices "
+                     f"[{run.scene.name}, frame {run.frame}, sync {kit.sync!r}]", frame=run.frame, target=name)
 
 
 @each_scene()
 def test_sync_keeps_the_mesh(scene_name, kit):
     """A sync moves vertices and nothing else: every actor keeps its vertex count, its cells
-    (topology) and its vertex colours, and the scene keeps its actors."""
-    spec = scenes.get(scene_name)
-    with kit.run(scene_name) as run:
-        for frame in [0, *run.frames(min(spec.steps, 30))]:
-            for name, actor in run.drawing.actors.items():
-                now = backends.mesh_signature(actor)
-                if now != run.built_mesh[name]:
-                    what = [w for w, a, b in zip(("vertex count", "cells", "colours"), now, run.built_mesh[name]) if a != b]
-                    pytest.fail(f"actor {name!r}: {', '.join(what)} changed, but a sync should only move vertices "
-                                f"[{scene_name}, frame {frame}, sync {kit.sync!r}]", pytrace=False)
+    (topology) and its vertex colours, and the scene keeps its actors (the first 30 frames)."""
+    shared_run.report(kit, "test_sync_keeps_the_mesh", scene_name)
 
 
 @each_scene()
@@ -181,16 +201,19 @@ def test_syncing_every_frame_equals_syncing_once(scene_name, kit):
     check()
 
 
+@shared_run.watcher("test_drawn_bounds_agree_with_get_aabb", last=lambda spec: min(spec.steps, EVERY_FRAME))
+def _bounds(run, kit):
+    steps = min(run.scene.steps, EVERY_FRAME)
+    if run.frame not in (0, steps // 2, steps):
+        return
+    for failure in (r for r in compare.compare_bounds(run.drawing, run.frame, kit.tolerance) if not r.ok):
+        kit.fail("bounds", f"{failure.target!r}: {'; '.join(failure.problems)} {_context(run, kit.sync, run.frame)}\n"
+                 f"reproduce: {reproduce_command(run.scene.name, kit.sync, run.frame, run.params)}",
+                 frame=run.frame, target=failure.target, **bounds_figure(failure.problems))
+
+
 @each_scene()
 def test_drawn_bounds_agree_with_get_aabb(scene_name, kit):
     """Each drawn body's world bounding box lies inside pybullet's ``getAABB`` and reaches it on every
     side within the stated margin (see ``conformance.tolerances``), at the first, middle and last frame."""
-    spec = scenes.get(scene_name)
-    steps = min(spec.steps, 400)
-    with kit.run(scene_name) as run:
-        for frame in (0, steps // 2, steps):
-            run.advance(frame - run.frame)
-            failures = [r for r in compare.compare_bounds(run.drawing, frame, kit.tolerance) if not r.ok]
-            if failures:
-                pytest.fail(f"{failures[0].target!r}: {'; '.join(failures[0].problems)} {_context(run, kit.sync, frame)}\n"
-                            f"reproduce: {reproduce_command(scene_name, kit.sync, frame, run.params)}", pytrace=False)
+    shared_run.report(kit, "test_drawn_bounds_agree_with_get_aabb", scene_name)

@@ -48,6 +48,12 @@ class Tolerance:
         distance = float(np.linalg.norm(position))
         return self.size_rtol * extent + self.position_rtol * (distance + extent) + self.atol
 
+    def for_extents(self, extents: np.ndarray, positions: np.ndarray) -> np.ndarray:
+        """:meth:`for_geometry` of many bodies at once, given each one's extent (largest vertex
+        distance from its link frame) and frame position ``(n, 3)``."""
+        distances = np.linalg.norm(np.asarray(positions, dtype=np.float64), axis=1)
+        return self.size_rtol * extents + self.position_rtol * (distances + extents) + self.atol
+
     def describe(self) -> str:
         return f"{self.size_rtol:g}·size + {self.position_rtol:g}·(distance from origin + size) + {self.atol:g} m"
 

@@ -43,18 +43,28 @@ def link_frame(p: BoundClient, body: int, link: int) -> tuple[np.ndarray, np.nda
 def link_frames(p: BoundClient, items: Sequence[tuple[int, int]]) -> tuple[np.ndarray, np.ndarray]:
     """Link-frame poses of many (body, link) pairs: positions ``(n, 3)`` and quaternions ``(n, 4)``.
 
-    The same arithmetic as :func:`link_frame`, batched: one scipy call for all bases."""
+    The same arithmetic as :func:`link_frame`, batched: one ``getLinkStates`` per body with links,
+    one scipy call for all bases, and pybullet called directly with the client id (the checks
+    call this every frame, so the bound client's per-call wrapping would show)."""
+    client = p.client
     n = len(items)
     positions = np.empty((n, 3))
     orientations = np.empty((n, 4))
-    bases = [i for i, (_, link) in enumerate(items) if link == -1]
+    links: dict[int, list[int]] = {}
+    bases = []
     for i, (body, link) in enumerate(items):
         if link >= 0:
-            state = p.getLinkState(body, link, computeForwardKinematics=1)
+            links.setdefault(body, []).append(i)
+        else:
+            bases.append(i)
+    for body, rows in links.items():
+        states = pybullet.getLinkStates(body, [items[i][1] for i in rows], computeForwardKinematics=1,
+                                        physicsClientId=client)
+        for i, state in zip(rows, states):
             positions[i], orientations[i] = state[4], state[5]
     if bases:
-        com = [p.getBasePositionAndOrientation(items[i][0]) for i in bases]
-        inertial = [p.getDynamicsInfo(items[i][0], -1)[3:5] for i in bases]
+        com = [pybullet.getBasePositionAndOrientation(items[i][0], physicsClientId=client) for i in bases]
+        inertial = [pybullet.getDynamicsInfo(items[i][0], -1, physicsClientId=client)[3:5] for i in bases]
         com_rot = Rotation.from_quat([c[1] for c in com])
         frame_rot = com_rot * Rotation.from_quat([l[1] for l in inertial]).inv()
         positions[bases] = np.array([c[0] for c in com]) - frame_rot.apply(np.array([l[0] for l in inertial]))

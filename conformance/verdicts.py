@@ -1,11 +1,16 @@
 """Run the conformance checks against several sync implementations and tabulate the verdicts.
 
 Each implementation is checked in its own pytest process (``-m sync``: the checks that run a sync)
-that writes a JSON report (``--conformance-report``); this module reads the reports and renders
-markdown: a scene × implementation table with the worst error measured, a property × implementation
-table, and the first failure of each failing check, which says why. It also computes the kill rate
-of a set of deliberately wrong implementations. No pytest import here: the plugin writes the
-records, this module only reads them.
+that writes a JSON report (``--conformance-report``) and keeps its pictures in a results directory of
+its own; this module reads the reports and renders markdown: a scene × implementation table, a
+property × implementation table, and why each implementation failed. It also computes the kill rate
+of a set of deliberately wrong implementations. No pytest run here: the plugin writes the records,
+this module only reads them (:mod:`conformance.survey` is where both agree on kinds and figures).
+
+``verdicts`` runs in survey mode (``--conformance-survey``): every check runs every frame and its
+record names every *kind* of failure it found (vertices, normals, Modified, bounds, …) with the
+worst figure of each, so a cell says everything an implementation gets wrong on a scene, not only
+what failed first. ``kill-rate`` needs only a first failure and stops there (``-x``, default mode).
 """
 
 from __future__ import annotations
@@ -15,10 +20,14 @@ import os
 import subprocess
 import sys
 import tempfile
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import ThreadPoolExecutor, as_completed
 from dataclasses import dataclass, field
 
-__all__ = ["Outcome", "check", "check_all", "command", "implementations", "kill_rate_table", "verdict_tables", "what_it_is"]
+from conformance import survey
+from conformance.progress import progress
+
+__all__ = ["Outcome", "check", "check_all", "command", "implementations", "kill_rate_table", "record_kinds",
+           "verdict_tables", "what_it_is"]
 
 
 @dataclass
@@ -71,20 +80,31 @@ def what_it_is(spec: str) -> str:
     return (text[:end.start()] if end else text).replace("|", "/")
 
 
-def command(spec: str, *, stop_at_first: bool = False, pytest_args=(), report: str | None = None) -> list[str]:
-    """The pytest command line that checks ``spec`` (what a user would type, with ``python -m``)."""
+def command(spec: str, *, stop_at_first: bool = False, survey: bool = False, pytest_args=(), report: str | None = None,
+            results: str | None = None) -> list[str]:
+    """The pytest command line that checks ``spec`` (what a user would type, with ``python -m``):
+    ``stop_at_first`` adds ``-x``; ``survey`` adds ``--conformance-survey``; ``results`` is where the
+    image checks keep their pictures (ignored when ``pytest_args`` name a results directory)."""
+    pytest_args = list(pytest_args)
     profile = [] if any(a.startswith("--hypothesis-profile") for a in pytest_args) else ["--hypothesis-profile", PROFILE]
+    own_results = results and not any(a.startswith("--conformance-results") for a in pytest_args)
     return [sys.executable, "-m", "pytest", "--pyargs", "conformance", "-m", "sync", "-q", "-p", "no:cacheprovider",
             "--sync", spec, *profile, *(["--conformance-report", report] if report else []),
-            *(["-x"] if stop_at_first else []), *pytest_args]
+            *(["--conformance-results", results] if own_results else []),
+            *(["--conformance-survey"] if survey else []), *(["-x"] if stop_at_first else []), *pytest_args]
 
 
-def check(spec: str, *, stop_at_first: bool = False, pytest_args=(), env=None) -> Outcome:
-    """Run the sync checks on ``spec`` in a pytest process of its own and read its report."""
+def check(spec: str, *, stop_at_first: bool = False, survey: bool = False, pytest_args=(), env=None) -> Outcome:
+    """Run the sync checks on ``spec`` in a pytest process of its own and read its report. The run's
+    pictures go to a temporary directory of its own, so runs side by side never share one."""
     with tempfile.TemporaryDirectory() as tmp:
         report = os.path.join(tmp, "report.json")
-        argv = command(spec, stop_at_first=stop_at_first, pytest_args=list(pytest_args), report=report)
-        proc = subprocess.run(argv, capture_output=True, text=True, env=env)
+        argv = command(spec, stop_at_first=stop_at_first, survey=survey, pytest_args=list(pytest_args), report=report,
+                       results=os.path.join(tmp, "results"))
+        from conformance.display import child_environment, dies_with_this_process
+
+        proc = subprocess.run(argv, capture_output=True, text=True, env=child_environment(env),
+                              preexec_fn=dies_with_this_process(waited_for=True))  # none outlives a killed command
         if not os.path.exists(report):
             return Outcome(spec, proc.returncode, [], (proc.stderr or proc.stdout)[-1500:])
         with open(report, encoding="utf-8") as fh:
@@ -92,29 +112,81 @@ def check(spec: str, *, stop_at_first: bool = False, pytest_args=(), env=None) -
         return Outcome(spec, proc.returncode, data["records"], proc.stderr[-1500:])
 
 
-def check_all(specs: list[str], *, stop_at_first: bool = False, pytest_args: list[str] = (), jobs: int | None = None,
-              env=None) -> list[Outcome]:
+def check_all(specs: list[str], *, stop_at_first: bool = False, survey: bool = False, pytest_args: list[str] = (),
+              jobs: int | None = None, env=None) -> list[Outcome]:
     """Run the sync checks for every spec, ``jobs`` processes at a time (default 1: the runs are
-    CPU-bound, so more processes than cores only slow each other); ``env`` is their environment."""
+    CPU-bound, so more processes than cores only slow each other); ``env`` is their environment.
+    Outcomes come back in the order of ``specs``; a bar on a terminal counts the finished ones."""
     with ThreadPoolExecutor(max_workers=jobs or 1) as pool:
-        return list(pool.map(lambda s: check(s, stop_at_first=stop_at_first, pytest_args=pytest_args, env=env), specs))
+        futures = [pool.submit(check, s, stop_at_first=stop_at_first, survey=survey, pytest_args=pytest_args, env=env)
+                   for s in specs]
+        for _ in progress(as_completed(futures), total=len(futures), what="implementations checked"):
+            pass
+        return [f.result() for f in futures]
+
+
+def record_kinds(record: dict) -> dict[str, dict]:
+    """The kinds of failure of one record, each with its worst figure: as the plugin wrote them, or,
+    for a record without them (an older report), the one kind its first failure shows."""
+    if record.get("outcome") != "failed":
+        return {}
+    if record.get("kinds"):
+        return record["kinds"]
+    message = record.get("message", "")
+    kind = survey.kind_of_failure(record["check"], message)
+    return {kind: survey.figure_from_message(kind, message)}
+
+
+def _merge_kinds(records: list[dict]) -> dict[str, tuple[dict, dict]]:
+    """kind -> (its worst figure over ``records``, the record it came from), in the order of :data:`survey.KINDS`."""
+    worst: dict[str, tuple[dict, dict]] = {}
+    for r in records:
+        for kind, fig in record_kinds(r).items():
+            if survey.worse(fig, worst.get(kind, (None,))[0]):
+                worst[kind] = (fig, r)
+    order = list(survey.KINDS)
+    return dict(sorted(worst.items(), key=lambda item: order.index(item[0]) if item[0] in order else len(order)))
 
 
 def _cell(records: list[dict]) -> str:
     if not records:
         return "–"
     failed = [r for r in records if r["outcome"] == "failed"]
+    if failed:
+        kinds = _merge_kinds(failed)
+        found = "<br>".join(f"{kind} {survey.format_figure(fig)}".strip() for kind, (fig, _) in kinds.items())
+        return f"✗ {len(failed)}/{len(records)}" + (f": {found}" if found else "")
     worst = [r["worst"] for r in records if r.get("worst")]
     ratio = max((w["ratio"] for w in worst), default=None)
     error = max((w["error"] for w in worst), default=None)
     measured = f" {error:.1e} m ({ratio:.2g}×tol)" if ratio is not None else ""
-    if failed:
-        return f"✗ {len(failed)}/{len(records)}{measured}"
     return f"✓{measured}"
 
 
+def _why(outcome: Outcome) -> list[str]:
+    """One line per kind of failure: its worst figure, where, and the message that showed it."""
+    lines = []
+    for kind, (fig, record) in _merge_kinds(outcome.failed).items():
+        having = [r for r in outcome.failed if kind in record_kinds(r)]
+        scenes = sorted({str(r["scene"]) for r in having if r["scene"]}, key=_scene_order)
+        where = f" on {record['scene']}" if record["scene"] else ""
+        target = f", {fig['target']!r}" if fig.get("target") else ""
+        spread = (f"; in {len(having)} check{'s' if len(having) != 1 else ''}"
+                  + (f" on {len(scenes)} scene{'s' if len(scenes) != 1 else ''} ({', '.join(scenes)})" if scenes else ""))
+        message = fig.get("message") or record.get("message", "")
+        worst = "worst " if fig.get("value") is not None else ""  # a kind without a measure: its first failure
+        lines.append(f"- `{outcome.spec}` · **{kind}**: {worst}{survey.format_figure(fig)}{where}{target}, "
+                     f"`{record['check']}`{spread}: {message[:300]}")
+    return lines
+
+
 def verdict_tables(outcomes: list[Outcome]) -> str:
-    """Markdown: scenes × implementations, properties × implementations, and why each failure failed."""
+    """Markdown: scenes × implementations, properties × implementations, and why each failure failed.
+
+    A passing cell gives the worst vertex error measured (and its ratio to the tolerance); a failing
+    one gives failing/total checks and every kind of failure with its worst figure (value, ratio to
+    the tolerance, frame). "Why" has one line per implementation and kind: the worst figure, where,
+    how widespread, and the message of the failure that showed it."""
     specs = [o.spec for o in outcomes]
     scenes = sorted({r["scene"] for o in outcomes for r in o.records if r["scene"]}, key=_scene_order)
     checks = sorted({r["check"] for o in outcomes for r in o.records})
@@ -126,19 +198,15 @@ def verdict_tables(outcomes: list[Outcome]) -> str:
     for check in checks:
         row = [_cell([r for r in o.records if r["check"] == check]) for o in outcomes]
         lines.append(f"| `{check}` | " + " | ".join(row) + " |")
-    lines += ["", "Why (the first failure of each failing check):", ""]
+    lines += ["", "Why (every kind of failure of each implementation: its worst figure, where, and the failure that "
+              "showed it):", ""]
     for o in outcomes:
         if o.passed:
             continue
         if not o.records:
             lines.append(f"- `{o.spec}`: the run did not complete: {o.stderr.strip().splitlines()[-1] if o.stderr.strip() else o.exitstatus}")
             continue
-        seen = set()
-        for r in o.failed:
-            if r["check"] in seen:
-                continue
-            seen.add(r["check"])
-            lines.append(f"- `{o.spec}` · `{r['check']}` [{r['scene']}]: {r['message'][:300]}")
+        lines += _why(o)
     return "\n".join(lines)
 
 

@@ -12,3 +12,30 @@ import conformance.test_vertices  # noqa: F401
 import PIL.Image  # noqa: F401
 
 pytest_plugins = ["pytester"]
+
+
+def pytest_collection_modifyitems(items):
+    """Tests that wait for a background run go last: until then this process runs everything else
+    while the runs use the other cores (``background``)."""
+    waits = [hasattr(getattr(item, "module", None), "background_runs") for item in items]
+    items[:] = [item for item, w in zip(items, waits) if not w] + [item for item, w in zip(items, waits) if w]
+
+
+def pytest_collection_finish(session):
+    """Start the subprocess runs the selected tests will need, all at once (see ``background``)."""
+    if hasattr(session.config, "workerinput") or session.config.getoption("collectonly"):
+        return
+    import background
+
+    runs = {}
+    for module in {item.module for item in session.items if hasattr(item, "module")}:
+        planner = getattr(module, "background_runs", None)
+        if planner is not None:
+            runs.update(planner([item for item in session.items if getattr(item, "module", None) is module]))
+    background.start_all(runs)
+
+
+def pytest_sessionfinish(session):
+    import background
+
+    background.stop()

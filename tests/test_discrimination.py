@@ -10,7 +10,7 @@ failed; not 2, 3 or 4, which are errors) with a failure that names the scene and
 (``[scene(params), frame N, …]``); a right one must make the same command without ``-x`` exit 0.
 The ``triage`` profile is derandomized, so every run of this file tries the same examples.
 
-The runs start together, one per core at a time, when the first of them is needed.
+The runs start with the session, one per core at a time (``background``).
 """
 
 from __future__ import annotations
@@ -18,11 +18,11 @@ from __future__ import annotations
 import inspect
 import os
 import re
-from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
 
+import background
 import right_syncs
 import wrong_syncs
 from conformance import scenes, verdicts
@@ -42,46 +42,33 @@ def _describe(outcome: verdicts.Outcome, stop_at_first: bool) -> str:
             f"{len(outcome.failed)} checks failed{':' if failures else '.'}\n{failures}\n{outcome.stderr[-800:]}")
 
 
-class _Runs:
-    """spec -> Future of its run, started on first use, or all at once by :meth:`start`."""
-
-    def __init__(self, pool: ThreadPoolExecutor, env: dict[str, str]):
-        self.pool, self.env, self.futures = pool, env, {}
-
-    def start(self, spec: str, stop_at_first: bool):
-        if spec not in self.futures:
-            self.futures[spec] = self.pool.submit(verdicts.check, spec, stop_at_first=stop_at_first, env=self.env)
-        return self.futures[spec]
-
-    def result(self, spec: str, stop_at_first: bool) -> verdicts.Outcome:
-        return self.start(spec, stop_at_first).result()
-
-
-@pytest.fixture(scope="module")
-def runs(request):
-    """The runs, one per core at a time. In a plain pytest process every selected run is started when
-    the first is needed; under pytest-xdist a worker runs only what it is given, so it starts each
-    run when its test comes."""
+def _env() -> dict[str, str]:
     env = dict(os.environ)
     env["PYTHONPATH"] = os.pathsep.join([str(TESTS), *filter(None, env.get("PYTHONPATH", "").split(os.pathsep))])
     env.pop("CONFORMANCE_SYNC", None)
-    with ThreadPoolExecutor(max_workers=os.cpu_count() or 1) as pool:
-        started = _Runs(pool, env)
-        if not hasattr(request.config, "workerinput"):
-            for item in request.session.items:
-                callspec = getattr(item, "callspec", None)
-                if item.module is request.module and callspec is not None and "spec" in callspec.params:
-                    started.start(callspec.params["spec"], item.originalname == "test_kit_fails_a_wrong_sync")
-        try:
-            yield started
-        finally:
-            for future in started.futures.values():
-                future.cancel()
+    return env
+
+
+def _run(spec: str, stop_at_first: bool):
+    """The run of ``spec`` (key and callable for :mod:`background`)."""
+    return f"discrimination:{spec}", lambda: verdicts.check(spec, stop_at_first=stop_at_first, env=_env())
+
+
+def background_runs(items) -> dict:
+    """Every selected run, to start with the session: a right sync runs every check, so it goes first."""
+    runs = {}
+    for item in items:
+        spec = getattr(item, "callspec", None) and item.callspec.params.get("spec")
+        if spec:
+            wrong = item.originalname == "test_kit_fails_a_wrong_sync"
+            key, call = _run(spec, stop_at_first=wrong)
+            runs[key] = (0 if wrong else 1, call)
+    return runs
 
 
 @pytest.mark.parametrize("spec", [pytest.param(s, id=s.partition(":")[2]) for s in WRONG])
-def test_kit_fails_a_wrong_sync(spec, runs):
-    outcome = runs.result(spec, stop_at_first=True)
+def test_kit_fails_a_wrong_sync(spec):
+    outcome = background.result(*_run(spec, stop_at_first=True))
     assert outcome.exitstatus == pytest.ExitCode.TESTS_FAILED and outcome.failed, (
         f"the kit should fail the wrong sync {spec} (exit 1), but {_describe(outcome, True)}")
     where = [m for r in outcome.failed for m in WHERE.finditer(r["message"]) if m["scene"] in scenes.names()]
@@ -89,8 +76,8 @@ def test_kit_fails_a_wrong_sync(spec, runs):
 
 
 @pytest.mark.parametrize("spec", [pytest.param(s, id=s.partition(":")[2]) for s in RIGHT])
-def test_kit_passes_a_right_sync(spec, runs):
-    outcome = runs.result(spec, stop_at_first=False)
+def test_kit_passes_a_right_sync(spec):
+    outcome = background.result(*_run(spec, stop_at_first=False))
     assert outcome.exitstatus == pytest.ExitCode.OK, f"the kit should pass the right sync {spec}, but {_describe(outcome, False)}"
 
 

@@ -18,10 +18,12 @@ def _pytest(*args, cwd):
 
 @pytest.mark.parametrize("args, message", [
     (["--conformance-image-tolerance", "loose"],
-     "conformance_image_tolerance='loose' (str), but should be one of auto, same-renderer, other-renderer"),
-    (["--conformance-golden-dir", "no/such/dir"], "is not a directory; give an existing directory of goldens, "
+     "--conformance-image-tolerance='loose' (str), but should be one of auto, same-renderer, other-renderer"),
+    (["--conformance-golden-dir", "no/such/dir"], "--conformance-golden-dir='no/such/dir' (str), but should be an "
+                                                 "existing directory; it does not exist; give the directory of goldens, "
                                                  "or add --regen-golden to make them there"),
-    (["--conformance-results", "a_file"], "is a file, but should be a directory"),
+    (["--conformance-results", "a_file"], "--conformance-results='a_file' (str), but should be a directory to write in "
+                                          "(made if missing); it is a file"),
 ])
 def test_bad_option_is_a_usage_error(tmp_path, args, message):
     (tmp_path / "a_file").write_text("not a directory")

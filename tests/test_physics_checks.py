@@ -6,10 +6,11 @@ from __future__ import annotations
 
 import inspect
 
+import numpy as np
 import pytest
 from hypothesis import given, settings
 
-from conformance import collisions, deviations, documented, strategies, sync
+from conformance import collisions, deviations, documented, physics, strategies, sync
 from conformance import test_filters as filters
 from conformance import test_forces as forces
 from conformance import test_materials as materials
@@ -172,7 +173,7 @@ def test_clamp_deviation_is_observed_on_this_pybullet():
 
 # -- gravity, time step, damping, materials ----------------------------------------------------
 def test_free_fall_check_fails_with_a_wrong_time_step():
-    with pytest.raises(Failed, match=r"vz=-0.1, but should be g·dt·n = -0.0416666667 .*\[free_fall\(.*step 1; setTimeStep\(0.01\)"):
+    with pytest.raises(Failed, match=r"vz=-0.1, but should be g·h·m \(h = dt/k, m sub-steps taken\) = -0.0416666667 .*\[free_fall\(.*step 1; setTimeStep\(0.01\)"):
         materials.verify_free_fall(TURNED, 1 / 100, 1, assumed_dt=1 / 240)
 
 
@@ -180,6 +181,15 @@ def test_free_fall_check_fails_when_sub_steps_are_ignored():
     with pytest.raises(Failed, match=r"z=.*but should be z0 \+ g·\(dt/k\)²·m\(m\+1\)/2"):
         # The premise broken: the closed form of one step of dt, although 4 sub-steps are set.
         materials.verify_free_fall(TURNED, 1 / 100, 4, assumed_substeps=1)
+
+
+def test_lost_sub_steps_are_bullets_clock_not_a_failure():
+    """For some time steps Bullet's sub-step clock falls just short and a sub-step is lost: the law
+    counts them as Bullet does (found by Hypothesis: dt = 0.0146824…, 3 sub-steps, failed before)."""
+    lossy = next(dt for dt in np.linspace(0.001, 0.02, 4001)
+                 if physics.substeps_taken(dt, 3, 60) != 180)
+    assert physics.substeps_taken(lossy, 3, 60) < 180
+    materials.verify_free_fall(TURNED, lossy, 3)  # pybullet really takes fewer sub-steps, and the law agrees
 
 
 def test_engine_defaults_check_fails_when_gravity_is_set():

@@ -5,18 +5,33 @@ from __future__ import annotations
 import re
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
+
+import background
+from conformance.display import child_environment, dies_with_this_process
 
 README = Path(__file__).resolve().parent.parent / "README.md"
 
 
-def test_readme_example_passes_every_sync_check(tmp_path):
+def _check_the_example() -> subprocess.CompletedProcess:
     text = README.read_text(encoding="utf-8")
     example = re.search(r"Save as `my_sync.py`.*?```python\n(.*?)```", text, re.S).group(1)
-    (tmp_path / "my_sync.py").write_text(example, encoding="utf-8")
-    proc = subprocess.run(
-        [sys.executable, "-m", "pytest", "--pyargs", "conformance", "-m", "sync", "-q", "-p", "no:cacheprovider",
-         "--sync", "my_sync:MySync"],
-        cwd=tmp_path, capture_output=True, text=True)
+    with tempfile.TemporaryDirectory() as where:
+        (Path(where) / "my_sync.py").write_text(example, encoding="utf-8")
+        return subprocess.run(
+            [sys.executable, "-m", "pytest", "--pyargs", "conformance", "-m", "sync", "-q", "-p", "no:cacheprovider",
+             "--sync", "my_sync:MySync"],
+            cwd=where, capture_output=True, text=True, env=child_environment(),
+            preexec_fn=dies_with_this_process(waited_for=True))
+
+
+def background_runs(items) -> dict:
+    """The example's run is as long as a right sync's: start it with the session (``background``)."""
+    return {"readme-example": (1, _check_the_example)}
+
+
+def test_readme_example_passes_every_sync_check():
+    proc = background.result("readme-example", _check_the_example)
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-2000:]
     assert " passed" in proc.stdout and "failed" not in proc.stdout.splitlines()[-1]

@@ -115,3 +115,12 @@ def test_scenes_command_lists_every_scene(capsys):
     out = capsys.readouterr().out
     for name in scenes.names():
         assert name in out
+
+
+def test_xvfb_that_fails_to_start_is_a_clear_error(monkeypatch):
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.setattr(display, "_started", None)
+    monkeypatch.setattr(display, "SCREEN", "not-a-screen")  # Xvfb refuses it and exits
+    with pytest.raises(DisplayUnavailable, match=r"Xvfb is installed but did not start \(exit status \d+; it said: .+\)"):
+        display.ensure_display()
+    assert "DISPLAY" not in __import__("os").environ and display._started is None

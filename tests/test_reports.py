@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from conformance import cli, verdicts
+from conformance import cli, survey, verdicts
+from conformance.commands.common import replace_block
 from conformance.errors import ConformanceError
 
 
@@ -28,12 +29,15 @@ def test_kill_rate_table_counts_survivors_and_rejected_right_ones():
     assert "| `r:Bad` | right | REJECTED | test_b [chain] |" in table
 
 
-def test_verdict_table_marks_failures_with_the_worst_error():
+def test_verdict_table_marks_passes_with_the_worst_error_and_failures_with_their_kinds():
+    failed = dict(_record("test_a", "chain", "failed", 3e4), kinds={"vertices": survey.figure(
+        value=0.03, limit=1e-6, unit="m", frame=3, target="link_0", message="x is off [chain, frame 3, sync 'w']")})
     outcomes = [verdicts.Outcome("ok", 0, [_record("test_a", "chain", "passed", 0.5)]),
-                verdicts.Outcome("bad", 1, [_record("test_a", "chain", "failed", 3e4), _record("test_b", "chain", "passed")])]
+                verdicts.Outcome("bad", 1, [failed, _record("test_b", "chain", "passed")])]
     table = verdicts.verdict_tables(outcomes)
-    assert "| chain | ✓ 5.0e-07 m (0.5×tol) | ✗ 1/2 3.0e-02 m (3e+04×tol) |" in table
-    assert "- `bad` · `test_a` [chain]: x is off [chain, frame 3, sync 'w']" in table
+    assert "| chain | ✓ 5.0e-07 m (0.5×tol) | ✗ 1/2: vertices 0.03 m (3e+04×tol, frame 3) |" in table
+    assert ("- `bad` · **vertices**: worst 0.03 m (3e+04×tol, frame 3) on chain, 'link_0', `test_a`; in 1 check on "
+            "1 scene (chain): x is off [chain, frame 3, sync 'w']") in table
 
 
 def test_implementations_are_the_modules_public_list():
@@ -50,7 +54,7 @@ def test_what_an_implementation_is_comes_from_its_docstring():
 def test_tables_replace_only_their_block_of_the_readme(tmp_path):
     readme = tmp_path / "README.md"
     readme.write_text("intro\n<!-- conformance:kill-rate -->\nold table\n<!-- /conformance:kill-rate -->\nrest\n")
-    cli._replace_block(str(readme), "kill-rate", "| new |\n")
+    replace_block(str(readme), "kill-rate", "| new |\n")
     assert readme.read_text() == "intro\n<!-- conformance:kill-rate -->\n| new |\n<!-- /conformance:kill-rate -->\nrest\n"
     assert not (tmp_path / "README.md.tmp").exists()
 
@@ -59,10 +63,10 @@ def test_readme_without_the_markers_is_a_clear_error_and_is_left_alone(tmp_path)
     readme = tmp_path / "README.md"
     readme.write_text("no markers here\n")
     with pytest.raises(ConformanceError, match=r"needs one line '<!-- conformance:verdicts -->' followed by"):
-        cli._replace_block(str(readme), "verdicts", "| t |")
+        replace_block(str(readme), "verdicts", "| t |")
     assert readme.read_text() == "no markers here\n"
     with pytest.raises(ConformanceError, match=r"cannot read it"):
-        cli._replace_block(str(tmp_path / "missing.md"), "verdicts", "| t |")
+        replace_block(str(tmp_path / "missing.md"), "verdicts", "| t |")
 
 
 def test_run_command_is_pytest_on_the_kit_and_says_so_in_its_exit_status(monkeypatch, capfd):
@@ -77,3 +81,27 @@ def test_run_command_is_pytest_on_the_kit_and_says_so_in_its_exit_status(monkeyp
     out, err = capfd.readouterr()
     assert "1 passed" in out and "1 failed" in out and "[free_fall" in out
     assert "PytestAssertRewriteWarning" not in out + err
+
+
+def test_verdicts_runs_in_survey_mode_and_kill_rate_stops_at_the_first_failure(monkeypatch, capsys):
+    argv = verdicts.command("s", survey=True, report="r.json", results="pics")
+    assert "--conformance-survey" in argv and argv[argv.index("--conformance-results") + 1] == "pics"
+    argv = verdicts.command("s", stop_at_first=True, results="pics", pytest_args=["--conformance-results=mine"])
+    assert "-x" in argv and "--conformance-survey" not in argv and "pics" not in argv
+    calls = []
+
+    def check_all(specs, **options):
+        calls.append(options)
+        return [verdicts.Outcome(spec, 0, []) for spec in specs]
+
+    monkeypatch.setattr(verdicts, "check_all", check_all)
+    assert cli.main(["verdicts", "reference"]) == 0
+    assert calls.pop()["survey"] is True
+    assert cli.main(["kill-rate", "--wrong", "wrong_syncs", "--right", "right_syncs"]) == 1  # nothing killed here
+    assert [c.get("survey", False) for c in calls] == [False, False] and calls[0]["stop_at_first"] is True
+
+
+def test_verdicts_refuses_a_spec_that_does_not_load_before_running_anything(monkeypatch, capsys):
+    monkeypatch.setattr(verdicts, "check_all", lambda *a, **k: pytest.fail("nothing should run"))
+    assert cli.main(["verdicts", "reference", "no_such_module:Sync"]) == 2
+    assert "error: sync implementation 'no_such_module:Sync': importing module 'no_such_module' failed" in capsys.readouterr().err

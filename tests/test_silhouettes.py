@@ -106,6 +106,24 @@ def test_fails_on_a_body_moved_by_two_pixels():
         assert "'body'" in record.message and "free_fall, frame 0" in record.message
 
 
+def test_which_body_is_in_front_is_left_out_but_where_each_is_counts():
+    """Pixels where the masks show two different targets are left out of both (renderers disagree
+    about which of two touching curved bodies is in front); a target drawn over background is not."""
+    fury = np.full((40, 40), -1)
+    fury[5:25, 5:25] = 0
+    fury[15:30, 15:30] = 1  # 1 in front of 0
+    bullet = np.full((40, 40), -1)
+    bullet[15:30, 15:30] = 1
+    bullet[5:25, 5:25] = 0  # 0 in front of 1
+    record = silhouettes.compare_silhouettes(fury, bullet, min_iou=0.98, slack=0)
+    assert record.passed, record.message
+    moved = np.full((40, 40), -1)
+    moved[15:30, 15:30] = 1
+    moved[5:25, 8:28] = 0  # and body 0 drawn 3 px to the right, over background
+    record = silhouettes.compare_silhouettes(fury, moved, min_iou=0.98, slack=0)
+    assert not record.passed and "#0" in record.message, record.message
+
+
 def _turn(actor, centre, axis, degrees):
     from scipy.spatial.transform import Rotation
 

@@ -17,6 +17,7 @@
 from __future__ import annotations
 
 import dataclasses
+import functools
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -129,17 +130,28 @@ def check_physics(scene_name: str, goldens: dict[int, storage.Golden]) -> list[P
     from conformance import scenes
 
     spec = scenes.get(scene_name)
-    verdicts = []
+    live = live_states(scene_name, tuple(sorted(goldens)))
+    return [PhysicsVerdict(frame, state.compare(live[frame], goldens[frame].state),
+                           spec.chaotic_after is not None and frame > spec.chaotic_after)
+            for frame in sorted(goldens)]
+
+
+@functools.lru_cache(maxsize=None)
+def live_states(scene_name: str, frames: tuple[int, ...]) -> dict[int, dict[str, Any]]:
+    """The bare scene's physics state (default parameters) at ``frames``, stepped once per process:
+    both golden verdicts of every sync run need it, and a scene steps the same way every time
+    (``test_is_deterministic_in_process``)."""
+    from conformance import scenes
+
+    states = {}
     with scenes.build(scene_name) as scene:
         done = 0
-        for frame in sorted(goldens):
+        for frame in frames:
             for step in range(done, frame):
                 scene.advance(step)
             done = frame
-            difference = state.compare(state.capture(scene), goldens[frame].state)
-            chaotic = spec.chaotic_after is not None and frame > spec.chaotic_after
-            verdicts.append(PhysicsVerdict(frame, difference, chaotic))
-    return verdicts
+            states[frame] = state.capture(scene)
+    return states
 
 
 @dataclass(frozen=True)

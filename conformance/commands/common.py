@@ -1,0 +1,47 @@
+"""What several commands share: JSON scene parameters, printing a table, filling a README block."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from conformance.errors import ConformanceError
+from conformance.files import write_atomically
+
+__all__ = ["emit", "params", "replace_block"]
+
+
+def params(text: str | None) -> dict:
+    """``--params`` as a dict of scene parameters (JSON lists become tuples)."""
+    if not text:
+        return {}
+    try:
+        value = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise ConformanceError(f"--params={text!r} is not JSON ({exc.msg}); write e.g. --params '{{\"rows\": 3}}'") from None
+    if not isinstance(value, dict):
+        raise ConformanceError(f"--params={text!r} is a JSON {type(value).__name__}, but should be an object of scene parameters")
+    return {k: tuple(v) if isinstance(v, list) else v for k, v in value.items()}
+
+
+def emit(text: str, out: str | None) -> None:
+    """Print ``text``; also write it to ``out`` if given."""
+    print(text)
+    if out:
+        write_atomically(Path(out), (text + "\n").encode("utf-8"))
+
+
+def replace_block(path: str, name: str, text: str) -> None:
+    """Put ``text`` between the lines ``<!-- conformance:NAME -->`` and ``<!-- /conformance:NAME -->``
+    of the markdown file ``path`` (written whole, atomically)."""
+    start, end = f"<!-- conformance:{name} -->", f"<!-- /conformance:{name} -->"
+    target = Path(path)
+    try:
+        old = target.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ConformanceError(f"--readme {path!r}: cannot read it ({exc.strerror})") from None
+    if old.count(start) != 1 or old.count(end) != 1 or old.index(start) > old.index(end):
+        raise ConformanceError(f"--readme {path!r}: needs one line {start!r} followed by one line {end!r} "
+                               "around the place the table goes")
+    new = old[:old.index(start) + len(start)] + "\n" + text.strip() + "\n" + old[old.index(end):]
+    write_atomically(target, new.encode("utf-8"))

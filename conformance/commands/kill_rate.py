@@ -1,0 +1,35 @@
+"""``kill-rate --wrong MODULE --right MODULE``: how many deliberately wrong syncs the checks reject."""
+
+from __future__ import annotations
+
+from conformance.commands.common import emit, replace_block
+from conformance.commands.verdicts import jobs
+from conformance.validation import argparse_type, existing_file, file_to_write, module_name
+
+NAME = "kill-rate"
+HELP = "check every class of a module of wrong syncs and one of right syncs"
+TAKES_PYTEST_ARGS = True
+
+
+def add_arguments(parser) -> None:
+    parser.add_argument("--wrong", required=True, type=argparse_type(module_name, "--wrong"), help="module whose classes are wrong sync implementations")
+    parser.add_argument("--right", required=True, type=argparse_type(module_name, "--right"), help="module whose classes are right sync implementations")
+    parser.add_argument("--out", type=argparse_type(file_to_write, "--out"), default=None, help="also write the markdown here")
+    parser.add_argument("--jobs", type=jobs, default=None, help="pytest processes at a time (default 1)")
+    parser.add_argument("--readme", type=argparse_type(existing_file, "--readme"), default=None, help="also put the table in this markdown file, between "
+                        "'<!-- conformance:kill-rate -->' and '<!-- /conformance:kill-rate -->'")
+
+
+def run(args, extra) -> int:
+    from conformance import verdicts
+
+    wrong, right = verdicts.implementations(args.wrong), verdicts.implementations(args.right)
+    # A wrong implementation needs only its first failure; a right one must pass everything.
+    outcomes = verdicts.check_all(wrong, stop_at_first=True, pytest_args=extra, jobs=args.jobs)
+    accepted = verdicts.check_all(right, pytest_args=extra, jobs=args.jobs)
+    summaries = {spec: verdicts.what_it_is(spec) for spec in wrong + right}
+    text = verdicts.kill_rate_table(outcomes, accepted, summaries)
+    emit(text, args.out)
+    if args.readme:
+        replace_block(args.readme, "kill-rate", text)
+    return 0 if all(o.failed for o in outcomes) and all(o.passed for o in accepted) else 1

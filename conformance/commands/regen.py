@@ -1,0 +1,40 @@
+"""``regen [SCENE…] [--missing | --failing]``: make golden snapshots anew and say what changed."""
+
+from __future__ import annotations
+
+from conformance import validation
+
+NAME = "regen"
+HELP = "make golden snapshots anew (reference sync), atomically; print what changed"
+
+
+def add_arguments(parser) -> None:
+    parser.add_argument("scene", nargs="*", help="scene names (default: every scene)")
+    which = parser.add_mutually_exclusive_group()
+    which.add_argument("--missing", action="store_true", help="only goldens that are missing or unreadable")
+    which.add_argument("--failing", action="store_true", help="only goldens that are missing, unreadable or fail "
+                       "the render check with the reference sync")
+    parser.add_argument("--golden-dir", default=None, help="directory of goldens (default: the kit's own)")
+
+
+def run(args, extra) -> int:
+    from conformance import scenes
+    from conformance.display import virtual_display
+    from conformance.progress import progress
+    from conformance.rendering import golden, snapshots
+
+    names = args.scene or scenes.names()
+    for name in names:
+        scenes.get(name)  # an unknown name fails before anything is rendered or written
+    directory = (validation.directory_to_write("--golden-dir", args.golden_dir) if args.golden_dir is not None
+                 else golden.default_dir())
+    mode = "missing" if args.missing else "failing" if args.failing else "all"
+    counts = {"new": 0, "changed": 0, "unchanged": 0}
+    with virtual_display():
+        for name in progress(names, total=len(names), what="goldens"):  # a bar on a terminal only
+            for change in snapshots.regenerate(name, directory, mode=mode):
+                counts[change.status] += 1
+                print(change.describe())
+    print(f"goldens in {directory}: {counts['new']} new, {counts['changed']} changed, {counts['unchanged']} unchanged"
+          + ("" if mode == "all" else f" (only {mode} ones were made)"))
+    return 0

@@ -1,0 +1,33 @@
+"""``run [--sync SPEC] [pytest args]``: the conformance checks, with a verdict per scene."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+from conformance import validation
+
+NAME = "run"
+HELP = "run the conformance checks (extra arguments go to pytest)"
+TAKES_PYTEST_ARGS = True
+
+
+def add_arguments(parser) -> None:
+    # read in run(), not by the command line's common code: an empty value is refused with `error:`
+    parser.add_argument("--sync", dest="sync_given", default=None, metavar="SPEC",
+                        help="sync implementation (short name or module:attribute; default: $CONFORMANCE_SYNC, "
+                        "else reference)")
+
+
+def run(args, extra: list[str]) -> int:
+    spec = validation.resolve_sync(args.sync_given)
+    # A pytest process of its own: in this one the kit is already imported, too late for pytest to
+    # rewrite its asserts. The plug-in starts (and stops) a virtual display if it needs one, and
+    # checks the other options (pytest's own usage errors exit with status 4).
+    argv = [sys.executable, "-m", "pytest", "--pyargs", "conformance", "-p", "no:cacheprovider", "--sync", spec, *extra]
+    from conformance.display import dies_with_this_process
+
+    # However this process ends (SIGTERM from a cancelled CI job, SIGKILL, Ctrl-C), pytest gets
+    # SIGTERM and stops its display on the way out: nothing is left running.
+    with subprocess.Popen(argv, preexec_fn=dies_with_this_process()) as pytest_run:
+        return pytest_run.wait()
