@@ -45,7 +45,8 @@ def _record(run, sync: str, ids_fury, ids_bullet):
     scene = run.scene
     record = silhouettes.compare_silhouettes(
         ids_fury, ids_bullet, min_iou=silhouettes.thresholds(scene.bindings),
-        names=[t.name for t in run.drawing.targets], scene=scene.name, frame=run.frame)
+        names=[t.name for t in run.drawing.targets], scene=scene.name, frame=run.frame,
+        touching=silhouettes.touching_pairs(scene, scene.bindings, ids_fury, ids_bullet))
     record.sync = sync
     record.params = golden.jsonable(dict(run.params))
     record.reproduce = reproduce_command(scene.name, sync, run.frame, run.params, run.events)

@@ -49,7 +49,8 @@ def check(run, camera=None):
     fury, bullet = masks(run, camera)
     return silhouettes.compare_silhouettes(fury, bullet, min_iou=silhouettes.thresholds(run.scene.bindings),
                                            names=[t.name for t in run.drawing.targets], scene=run.scene.name,
-                                           frame=run.frame)
+                                           frame=run.frame,
+                                           touching=silhouettes.touching_pairs(run.scene, run.scene.bindings, fury, bullet))
 
 
 def test_single_box_matches_pixel_for_pixel_and_top_row_first():
@@ -106,22 +107,45 @@ def test_fails_on_a_body_moved_by_two_pixels():
         assert "'body'" in record.message and "free_fall, frame 0" in record.message
 
 
-def test_which_body_is_in_front_is_left_out_but_where_each_is_counts():
-    """Pixels where the masks show two different targets are left out of both (renderers disagree
-    about which of two touching curved bodies is in front); a target drawn over background is not."""
+def test_which_of_two_touching_bodies_is_in_front_is_left_out_but_where_each_is_counts():
+    """Pixels where the masks show two different targets are left out of both when pyBullet has the
+    two in contact (renderers disagree about which of two touching curved bodies is in front); between
+    bodies apart, and where a target is drawn over background, every pixel counts."""
     fury = np.full((40, 40), -1)
     fury[5:25, 5:25] = 0
     fury[15:30, 15:30] = 1  # 1 in front of 0
     bullet = np.full((40, 40), -1)
     bullet[15:30, 15:30] = 1
     bullet[5:25, 5:25] = 0  # 0 in front of 1
-    record = silhouettes.compare_silhouettes(fury, bullet, min_iou=0.98, slack=0)
+    record = silhouettes.compare_silhouettes(fury, bullet, min_iou=0.98, slack=0, touching={(0, 1)})
     assert record.passed, record.message
+    apart = silhouettes.compare_silhouettes(fury, bullet, min_iou=0.98, slack=0)  # not in contact: it counts
+    assert not apart.passed, apart.message
     moved = np.full((40, 40), -1)
     moved[15:30, 15:30] = 1
     moved[5:25, 8:28] = 0  # and body 0 drawn 3 px to the right, over background
-    record = silhouettes.compare_silhouettes(fury, moved, min_iou=0.98, slack=0)
+    record = silhouettes.compare_silhouettes(fury, moved, min_iou=0.98, slack=0, touching={(0, 1)})
     assert not record.passed and "#0" in record.message, record.message
+
+
+def test_touching_pairs_are_bodies_in_contact():
+    """A cylinder sunk into the ground (the case the orientation property once failed a right sync on)
+    is in contact with it; two spheres half a metre apart are not."""
+    from conformance import events
+    from conformance.pytest_helpers import sync_run
+
+    turn = events.loads('[{"kind":"teleport","frame":0,"which":0,"offset":[0.0,0.0,0.0],'
+                        '"orientation":[0.7071067811865476,4.329780281177467e-17,0.0,0.7071067811865476]}]')
+    params = {"count": 12, "grouping": "per_body", "moving": 0.5, "seed": 0, "size_range": (0.08, 0.25)}
+    with sync_run("mixed_shapes", REFERENCE, events=turn, **params) as run:
+        names = [t.name for t in run.drawing.targets]
+        cylinder, ground, sphere = (names.index(n) for n in ("cylinder4", "ground", "sphere8"))
+        everywhere = np.zeros((2, 2), dtype=int)
+        fury, bullet = everywhere + cylinder, everywhere + ground
+        fury[0, 0], bullet[0, 0] = cylinder, sphere
+        pairs = silhouettes.touching_pairs(run.scene, run.scene.bindings, fury, bullet)
+        assert pairs == {tuple(sorted((cylinder, ground)))}
+        assert check(run).passed
 
 
 def _turn(actor, centre, axis, degrees):
