@@ -92,5 +92,5 @@ def run(options: Options) -> Results:
     for task in progress(tasks, total=len(tasks), what="bench"):
         task()
         gc.collect()  # let the last task's actors and clients go before the next is timed
-    results.verdicts = targets.evaluate(results.syncs, options.subject, options.limits)
+    results.verdicts = targets.evaluate(results.syncs, options.subject, options.limits) + targets.evaluate_suite(results.suite)
     return results

@@ -11,6 +11,10 @@ For the sync under judgement (``reference`` unless ``--sync`` names another), in
 * **right**: the kit's vertex check passes on its drawing after the timed frames at every size: a
   sync cannot meet the others by skipping work.
 
+And for whole runs (``--suite``): ``pytest conformance`` serial within 90 s, with ``-n 2`` within 60 s,
+and ``./kit test`` within 5 minutes, each exiting 0 (the team's targets for this 2-core machine; on
+another machine they say how it compares).
+
 Where a target cannot be met by any sync that reads every pose, because the floor itself (pyBullet's
 per-body read) does not meet it, the verdict says so with the floor's figure.
 """
@@ -22,7 +26,7 @@ from typing import Sequence
 
 from .syncs import FLOOR, GUIDE_RECIPES, STYLES, SyncFigure
 
-__all__ = ["Limits", "Verdict", "evaluate"]
+__all__ = ["Limits", "SUITE_LIMITS", "Verdict", "evaluate", "evaluate_suite"]
 
 
 @dataclass(frozen=True)
@@ -97,4 +101,21 @@ def evaluate(figures: Sequence[SyncFigure], subject: str, limits: Limits = Limit
                         "; ".join(f"{f.wrong:,} of {f.bodies:,} wrong" for f in wrong)) + f", worst vertex error {worst:.2g} m"
             verdicts.append(Verdict(f"`{subject}` draws every body right (the kit's vertex check), {where}",
                                     measured, not wrong))
+    return verdicts
+
+
+#: Whole runs and the wall time each should stay within, in seconds.
+SUITE_LIMITS = {"`pytest conformance`": 90.0, "`pytest conformance -n 2`": 60.0, "`./kit test`": 300.0}
+
+
+def evaluate_suite(figures) -> list[Verdict]:
+    """Pass or miss of each whole run with a limit in :data:`SUITE_LIMITS` that was measured."""
+    verdicts = []
+    for figure in figures:
+        limit = SUITE_LIMITS.get(figure.name)
+        if limit is None:
+            continue
+        measured = f"{figure.seconds:.1f} s" + ("" if figure.returncode == 0 else f", exit {figure.returncode}")
+        verdicts.append(Verdict(f"{figure.name} within {limit:g} s, exit 0", measured,
+                                figure.seconds <= limit and figure.returncode == 0))
     return verdicts

@@ -241,6 +241,19 @@ def test_whole_runs_are_timed_with_their_exit_status_and_tabled():
                                                       "`pytest conformance -n 2`", "`./kit test`"]
 
 
+def test_whole_runs_pass_their_time_limits_only_in_time_and_with_exit_0():
+    base = dict(command="…", baseline=1.0)
+    figures = [suite.SuiteFigure("`pytest conformance`", seconds=80.0, **base),
+               suite.SuiteFigure("`pytest conformance -n 2`", seconds=61.0, **base),
+               suite.SuiteFigure("`./kit test`", seconds=100.0, returncode=1, **base),
+               suite.SuiteFigure("`pytest --collect-only conformance`", seconds=1.0, **base)]
+    verdicts = {v.target.split(" within")[0]: v for v in targets.evaluate_suite(figures)}
+    assert verdicts["`pytest conformance`"].passed
+    assert not verdicts["`pytest conformance -n 2`"].passed  # over 60 s
+    assert not verdicts["`./kit test`"].passed and "exit 1" in verdicts["`./kit test`"].measured
+    assert len(verdicts) == 3  # collection has no limit
+
+
 def _machine():
     from benchmarks import machine
 
