@@ -16,12 +16,12 @@ The scenes are the kit's own, at a frame in the middle of the action, synced by 
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 from conformance import backends, runner, scenes, sync
 from conformance.rendering import compare, silhouettes
 
-from .timing import Candidate, race
+from .timing import Candidate, RatioToBaseline, race
 
 __all__ = ["FRAME", "PictureFigure", "SCENES", "measure"]
 
@@ -31,7 +31,7 @@ FRAME = "one frame: `stepSimulation()` + `reference` sync"
 
 
 @dataclass(frozen=True)
-class PictureFigure:
+class PictureFigure(RatioToBaseline):
     """``seconds`` per call of ``name`` on ``scene``; ``baseline``: one frame of the same scene."""
 
     scene: str
@@ -39,13 +39,6 @@ class PictureFigure:
     seconds: float
     baseline: float
     size: tuple[int, int]
-
-    @property
-    def ratio(self) -> float:
-        return self.seconds / self.baseline
-
-    def as_dict(self) -> dict:
-        return {**asdict(self), "ratio": self.ratio}
 
 
 def measure(scene_name: str, *, repeats: int, number: int = 1) -> list[PictureFigure]:

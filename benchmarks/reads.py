@@ -18,14 +18,14 @@ from __future__ import annotations
 
 import functools
 import itertools
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import numpy as np
 import pybullet
 from vtkmodules.vtkCommonMath import vtkMatrix4x4
 
 from . import grid
-from .timing import Candidate, race
+from .timing import Candidate, RatioToBaseline, race
 
 __all__ = ["FLOOR_READ", "LINKS_PER_BODY", "ReadFigure", "measure"]
 
@@ -35,20 +35,13 @@ LINKS_PER_BODY = 10
 
 
 @dataclass(frozen=True)
-class ReadFigure:
+class ReadFigure(RatioToBaseline):
     """``seconds`` per pose read the way ``name`` says; ``baseline``: the floor's read, per pose."""
 
     name: str
     note: str
     seconds: float
     baseline: float
-
-    @property
-    def ratio(self) -> float:
-        return self.seconds / self.baseline
-
-    def as_dict(self) -> dict:
-        return {**asdict(self), "ratio": self.ratio}
 
 
 def measure(bodies: int, *, repeats: int, number: int = 10) -> list[ReadFigure]:

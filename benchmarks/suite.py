@@ -16,13 +16,13 @@ from __future__ import annotations
 
 import subprocess
 import sys
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Sequence
 
 from conformance import scenes
 
-from .timing import Candidate, race, timed
+from .timing import Candidate, RatioToBaseline, race, timed
 
 __all__ = ["BASELINE", "ROOT", "SuiteFigure", "commands", "measure", "physics_of_every_scene"]
 
@@ -31,7 +31,7 @@ BASELINE = "the physics of every reference scene once (build + every step, in pr
 
 
 @dataclass(frozen=True)
-class SuiteFigure:
+class SuiteFigure(RatioToBaseline):
     """``seconds`` of wall time of ``name`` (``command``), which exited with ``returncode``."""
 
     name: str
@@ -40,13 +40,6 @@ class SuiteFigure:
     baseline: float
     returncode: int = 0
     tail: str = ""  # the end of its output when it failed
-
-    @property
-    def ratio(self) -> float:
-        return self.seconds / self.baseline
-
-    def as_dict(self) -> dict:
-        return {**asdict(self), "ratio": self.ratio}
 
 
 def commands(python: str = sys.executable) -> list[tuple[str, list[str]]]:
