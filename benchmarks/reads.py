@@ -6,8 +6,10 @@ call is made (keyword or positional client id, a ``functools.partial``, the kit'
 a Python loop or ``map``), and, for links, one ``getLinkStates`` per body or one ``getLinkState`` per
 link. Also timed, to show where the floor's time goes: a pyBullet call that reads nothing
 (``isConnected``: the price of crossing from Python to pyBullet), turning the poses into one numpy
-array (what a vectorised sync adds), and the two per-body C calls a whole-actor sync adds
-(``getMatrixFromQuaternion`` and ``vtkMatrix4x4.DeepCopy``).
+array (what a vectorised sync adds), pyBullet's rotation matrix of a pose
+(``getMatrixFromQuaternion``), and what a whole-actor sync writes per body on the backend in force
+(:func:`.backend.actor_writes`): on FURY 0.12 ``vtkMatrix4x4.DeepCopy`` of its user matrix, on FURY 2
+the ``actor.local`` setters (``position``; ``position`` and ``rotation``; ``components``; ``matrix``).
 
 Every candidate reads ``bodies`` poses after an untimed ``stepSimulation()`` of its scene; the
 figure is seconds per pose, the ratio is to the floor's read,
@@ -22,9 +24,8 @@ from dataclasses import dataclass
 
 import numpy as np
 import pybullet
-from vtkmodules.vtkCommonMath import vtkMatrix4x4
 
-from . import grid
+from . import backend, grid
 from .timing import Candidate, RatioToBaseline, race
 
 __all__ = ["FLOOR_READ", "LINKS_PER_BODY", "ReadFigure", "measure"]
@@ -48,12 +49,11 @@ def measure(bodies: int, *, repeats: int, number: int = 10) -> list[ReadFigure]:
     """Every way of reading ``bodies`` base poses, and as many link poses (``LINKS_PER_BODY`` a body)."""
     read, flatten = pybullet.getBasePositionAndOrientation, itertools.chain.from_iterable
     with grid.grid(bodies, shared=True) as scene, \
-            grid.chains(max(1, bodies // LINKS_PER_BODY), LINKS_PER_BODY) as chains:
+            grid.chains(max(1, bodies // LINKS_PER_BODY), LINKS_PER_BODY) as chains, \
+            backend.actor_writes(bodies) as writes:
         c, ids, bound = scene.client, [b.body for b in scene.bindings], scene.p
         once = functools.partial(read, physicsClientId=c)
         orientations = [read(b, c)[1] for b in ids]
-        matrices, elements = [vtkMatrix4x4() for _ in ids], tuple(float(k) for k in range(16))
-        copy = vtkMatrix4x4.DeepCopy
         k = chains.client
         links = {}
         for b in chains.bindings:
@@ -79,11 +79,10 @@ def measure(bodies: int, *, repeats: int, number: int = 10) -> list[ReadFigure]:
             "a pyBullet call that reads nothing: the cost of the call itself", len(ids),
             lambda: [pybullet.isConnected(c) for b in ids], scene)
         per_pose["`getMatrixFromQuaternion(q)`, in a loop"] = (
-            "what a whole-actor sync adds per body: the rotation matrix", len(ids),
+            "a pose's rotation matrix: one per body for a VTK user matrix (FURY 2 takes the quaternion)", len(ids),
             lambda: [pybullet.getMatrixFromQuaternion(q) for q in orientations], scene)
-        per_pose["`vtkMatrix4x4.DeepCopy(m, 16 numbers)`, in a loop"] = (
-            "what a whole-actor sync adds per body: the user matrix", len(ids),
-            lambda: [copy(m, elements) for m in matrices], scene)
+        for name, (note, fn) in writes.items():  # the backend's own: what a whole-actor sync writes per body
+            per_pose[name] = (note, bodies, fn, scene)
         per_pose["`getLinkState(b, l, computeForwardKinematics=1)`, per link"] = (
             f"links of {LINKS_PER_BODY}-link bodies, one call each", len(pairs),
             lambda: [pybullet.getLinkState(b, l, computeForwardKinematics=1, physicsClientId=k) for b, l in pairs], chains)

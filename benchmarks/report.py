@@ -107,7 +107,7 @@ def _suite_table(results: Results) -> list[str]:
 def markdown(results: Results) -> str:
     """The tables, each introduced by what its figures are ratios to."""
     o = results.options
-    out = [f"Measured {results.started} on {machine.describe(results.machine)}. Every figure is a ratio to a "
+    out = [f"Measured {results.started} on {machine.describe(results.machine, results.renderer)}. Every figure is a ratio to a "
            f"baseline measured in the same run and process, each the best of {o.repeats} rounds "
            "(`python -m conformance bench`, code in `benchmarks/`)."]
     if results.syncs:
@@ -123,8 +123,7 @@ def markdown(results: Results) -> str:
                 f"per pose, as a ratio to the floor's read, {reads.FLOOR_READ}:", ""] + _reads_table(results)
         out += [""] + _floor_paragraph(results)
     if results.pictures:
-        renderer = results.renderer.get("gl_renderer", "")
-        out += ["", f"**Pictures** at the scenes' own size{f' ({renderer})' if renderer else ''}, as a ratio to "
+        out += ["", "**Pictures** at the scenes' own size (drawn by the GPU named above), as a ratio to "
                 f"{pictures.FRAME.split(': ', 1)[0]} of the same scene ({pictures.FRAME.split(': ', 1)[1]}; its own time given):",
                 ""] + _pictures_table(results)
     if results.suite:

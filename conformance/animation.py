@@ -1,7 +1,7 @@
 """Watch a scene move as a sync draws it: an animated GIF (or MP4) of chosen frames, failing ones marked.
 
 :func:`check_frame` is the frame check of ``python -m conformance check`` (every target's worst
-vertex and normal against pyBullet, and changes the sync made without telling VTK), so a frame
+vertex and normal against pyBullet, and changes the sync made without telling the renderer), so a frame
 marked here is a frame ``check`` reports. :func:`record` runs a scene, checks and renders each
 chosen frame, and writes the animation; what is guaranteed:
 
@@ -76,7 +76,7 @@ def check_frame(run, frame: int) -> FrameCheck:
     normals = compare.compare_normals(run.drawing, frame)
     ranked = [(_ratio(r.error, r.tolerance), r.describe()) for r in vertices if not r.ok]
     ranked += [(_ratio(r.angle, r.tolerance), r.describe()) for r in normals if not r.ok]
-    unannounced = [f"actor {name!r} changed without Modified()" for f, name in run.unannounced if f == frame]
+    unannounced = [f"actor {name!r} changed unannounced" for f, name in run.unannounced if f == frame]
     problems = tuple([text for _, text in ranked] + unannounced)
     worst = max(vertices, key=lambda r: _ratio(r.error, r.tolerance)).describe() if vertices else "no targets"
     worst_problem = max(ranked, key=lambda item: item[0])[1] if ranked else (unannounced[0] if unannounced else None)

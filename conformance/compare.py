@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from conformance import backends, poses, shapes, truth
-from conformance.backends import Drawing
+from conformance.backends.common import Drawing
 from conformance.tolerances import DEFAULT, Tolerance
 
 __all__ = [

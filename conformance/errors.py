@@ -8,6 +8,7 @@ value that was wrong, and what to do about it.
 from __future__ import annotations
 
 __all__ = [
+    "BackendError",
     "BadArgument",
     "ConformanceError",
     "DisplayUnavailable",
@@ -40,6 +41,11 @@ class BadArgument(InvalidArgument):
 
 class SceneError(ConformanceError):
     """A reference scene cannot be built or described as asked."""
+
+
+class BackendError(ConformanceError):
+    """No backend for the installed FURY (none installed, or a version the kit has no backend for),
+    or the backend's renderer cannot start (no Vulkan adapter for FURY 2)."""
 
 
 class DisplayUnavailable(ConformanceError):

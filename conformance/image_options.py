@@ -106,9 +106,11 @@ class Pictures:
         from conformance.rendering import golden
 
         versions = ", ".join(f"{name} {version}" for name, version in golden.library_versions().items())
-        renderers = sorted({" / ".join(r["details"]["renderer"].get(k, "?") for k in ("gl_vendor", "gl_renderer", "gl_version"))
+        from conformance import backends
+
+        renderers = sorted({backends.renderer_label(r["details"]["renderer"])
                             for r in (record.to_json() for record in records) if "renderer" in r["details"]})
-        header = [f"sync under test: {sync}", f"versions: {versions}",
+        header = [f"sync under test: {sync}", backends.describe(), f"versions: {versions}",
                   *(f"renderer: {r}" for r in renderers), self.describe()]
         self.report_path = report.write_report(records, self.results, title="FURY–pyBullet image checks",
                                                header_lines=header)

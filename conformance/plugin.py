@@ -17,7 +17,7 @@ Options live under one group, each mirrored by an ini setting:
   pictures of passing image checks too), and ``--regen-golden`` (make the selected scenes' goldens anew
   before checking them; never done without it).
 
-Loading this plugin is cheap: it imports pybullet, VTK and the sync only when a conformance check
+Loading this plugin is cheap: it imports pybullet, the renderer and the sync only when a conformance check
 is collected, so it stays out of the way of unrelated test suites in the same environment.
 """
 
@@ -140,14 +140,20 @@ def pytest_report_header(config: pytest.Config) -> list[str]:
     import importlib.metadata as md
 
     versions = []
-    for dist in ("pybullet", "fury", "vtk", "numpy", "hypothesis"):
+    for dist in ("pybullet", "numpy", "hypothesis"):
         try:
             versions.append(f"{dist} {md.version(dist)}")
         except md.PackageNotFoundError:
             versions.append(f"{dist} missing")
-    from conformance import image_options
+    from conformance import backends, image_options
+    from conformance.errors import BackendError
 
+    try:
+        backend = backends.describe()
+    except BackendError as exc:
+        backend = f"no backend: {exc}"
     return [
+        f"conformance: {backend}",
         f"conformance: sync {_sync_spec(config)!r}; {profiles.describe()}; tolerance {tolerance_from(config).describe()}",
         "conformance: " + ", ".join(versions),
         "conformance: " + image_options.from_config(config).describe(),
@@ -267,7 +273,10 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus) -> None:
     from conformance.files import write_atomically
 
     records = session.config.stash.get(_RECORDS_KEY, [])
-    payload = {"sync": _sync_spec(session.config), "exitstatus": int(exitstatus), "records": records}
+    from conformance import backends
+
+    payload = {"sync": _sync_spec(session.config), "backend": backends.NAME, "fury": backends.fury_version(),
+               "exitstatus": int(exitstatus), "records": records}
     write_atomically(path, json.dumps(payload, indent=1, default=float).encode("utf-8"))  # never half a report
 
 
@@ -279,7 +288,9 @@ def pytest_terminal_summary(terminalreporter, exitstatus, config: pytest.Config)
     if not verdicts:
         return
     tr = terminalreporter
-    tr.section(f"conformance verdict per scene (sync {_sync_spec(config)!r})")
+    from conformance import backends
+
+    tr.section(f"conformance verdict per scene (sync {_sync_spec(config)!r}, {backends.NAME} backend)")
     width = max(len(name) for name in verdicts)
     for scene, outcomes in verdicts.items():
         failed = len(outcomes.get("failed", []))

@@ -101,8 +101,10 @@ def _normals_message(failures: Sequence[Any], run: Any, sync: str) -> str:
 
 
 def _unannounced_message(frame: int, actor: str, run: Any, sync: str) -> str:
+    from conformance import backends
+
     return (f"actor {actor!r}: the sync changed its vertex data at frame {frame} without marking it modified "
-            "(no Modified()/utils.update_actor), so a live VTK window keeps drawing the old vertices "
+            f"(no {backends.ANNOUNCE}), so a live window keeps drawing the old vertices "
             f"{_context(run, sync, frame)}")
 
 
@@ -123,7 +125,7 @@ def assert_normals_turn(results: Iterable[Any], *, run: Any, sync: str) -> None:
 
 
 def assert_changes_announced(run: Any, *, sync: str) -> None:
-    """Every change a sync makes to an actor's data is announced to VTK (``Modified()``), or a live
+    """Every change a sync makes to an actor's data is announced to the renderer (``Modified()``, ``update_range``), or a live
     renderer keeps drawing the old vertices (FURY's ``utils.update_actor`` does this)."""
     __tracebackhide__ = True
     if run.unannounced:
@@ -189,7 +191,7 @@ class Kit:
 
     def assert_frame(self, run: Any) -> None:
         """What is drawn now is right: vertices where pybullet says, normals turned with them, and
-        every change announced to VTK. Survey mode checks all three and notes what failed."""
+        every change announced to the renderer. Survey mode checks all three and notes what failed."""
         __tracebackhide__ = True
         results = compare.compare_vertices(run.drawing, run.frame, self.tolerance)
         self._record(results)

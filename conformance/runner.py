@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 from typing import Any, Iterator, Mapping, Sequence
 
 from conformance import backends
-from conformance.backends import Drawing
+from conformance.backends.common import Drawing
 from conformance.events import Event
 from conformance.scenes import Scene, build
 from conformance.sync import Syncer, SyncImplementation
@@ -36,7 +36,7 @@ class Run:
             self._by_frame[event.frame].append(event)
         #: Each actor's vertex count, topology and colours as built, before any sync.
         self.built_mesh = {name: backends.mesh_signature(a) for name, a in self.drawing.actors.items()}
-        #: (frame, actor name) of every sync that changed an actor's data without telling VTK.
+        #: (frame, actor name) of every sync that changed an actor's data without telling the renderer.
         self.unannounced: list[tuple[int, str]] = []
         self._after: dict[str, tuple[int, bytes]] = {}
 
@@ -48,8 +48,9 @@ class Run:
         self.scene.advance(self.frame - 1)
 
     def sync(self) -> None:
-        """Call the sync under test for the current frame, noting changes VTK was not told about: a
-        live renderer re-uploads geometry only when the data's modification time moves."""
+        """Call the sync under test for the current frame, noting changes the renderer was not told
+        about: a live renderer re-uploads geometry only when the data's modification time (VTK) or
+        revision (pygfx) moves. Then hand the announced changes over, as a live window's next frame does."""
         actors = self.drawing.actors
         # What an actor held after the last sync is what it holds now unless its time moved since
         # (a render swaps colours, say), so each frame copies every actor's data once, not twice.
@@ -62,6 +63,7 @@ class Run:
         for name, (mtime, content) in self._after.items():
             if content != before[name][1] and mtime <= before[name][0]:
                 self.unannounced.append((self.frame, name))
+        backends.flush(self.drawing)
 
     def advance(self, frames: int = 1) -> None:
         """Step and sync ``frames`` times."""

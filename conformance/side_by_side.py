@@ -10,12 +10,12 @@ after set-up), then one step and one sync each per frame. At every frame, for ev
   in units of that target's tolerance.
 
 Besides, it notes the first frame at which either sync changed pyBullet's state (it must only read
-it) and every change either made to an actor's data without telling VTK (``Modified()``).
+it) and every change either made to an actor's data without telling the renderer (``Modified()``).
 
 What is guaranteed: a :class:`SceneComparison` holds, per target, the largest gap and its frame and
 each side's worst error and its frame, over every frame that ran; a side "agrees with pyBullet" on a
 scene when every error of it was within tolerance at every frame (a non-finite vertex never is), it
-announced every change to VTK, left pyBullet's state alone and did not raise. A sync that
+announced every change to the renderer, left pyBullet's state alone and did not raise. A sync that
 raises stops the scene's comparison at that frame (:attr:`SceneComparison.error` says which side,
 which scene, which frame, and what was raised); the frames before it are kept.
 """
@@ -139,7 +139,7 @@ class SceneComparison:
 
     def agrees(self, side: str) -> bool:
         """Whether pyBullet agrees with ``side`` everywhere on this scene: it drew every vertex right,
-        told VTK of every change (or a live window shows the old vertices), left pyBullet's state
+        told the renderer of every change (or a live window shows the old vertices), left pyBullet's state
         alone, and did not raise."""
         return (self.raised != side and self.draws_right(side) and side not in self.touched_physics
                 and not self.unannounced.get(side))

@@ -60,7 +60,8 @@ _SETTLED = pytest.StashKey[str]()
 KINDS: Mapping[str, str] = {
     "vertices": "a vertex drawn away from where pyBullet's pose puts it",
     "normals": "a stored vertex normal not turned with its body (lit wrongly)",
-    "Modified": "vertex data changed without Modified()/utils.update_actor (a live window keeps the old picture)",
+    "Modified": "vertex data changed without telling the renderer (FURY 0.12: Modified()/utils.update_actor; "
+                "FURY 2: positions.update_range()/update_full()), so a live window keeps the old picture",
     "bounds": "a drawn box outside getAABB, or short of it",
     "mesh": "vertex count, cells or colours changed by the sync",
     "physics touched": "the sync changed pyBullet's state",

@@ -7,7 +7,7 @@ holding the physics state of that frame. Each golden gets two verdicts, reported
 * ``test_golden_render``: restore the stored physics state, let the sync under test draw it, render,
   compare with the golden within the image tolerance set in force (:mod:`conformance.rendering.compare`).
   It judges the sync and the renderer, independent of any drift in physics. The frames are restored
-  in order in one run, so data changed without telling VTK, a frame drawn late, recoloured bodies or
+  in order in one run, so data changed without telling the renderer, a frame drawn late, recoloured bodies or
   a moved camera all show.
 * ``test_golden_physics``: the live run's state at each golden frame against the stored one: a
   failure here is pyBullet or the platform, not rendering. Past a scene's chaotic step (the wrecking

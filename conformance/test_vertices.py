@@ -3,8 +3,8 @@
 Ground truth is the kit's own (``conformance.truth``): each target's geometry captured in its link
 frame when the actor was built, moved by pybullet's link-frame pose (base:
 ``getBasePositionAndOrientation`` with the inertial offset undone; link: ``getLinkState(...)[4:6]``
-with forward kinematics); read-back is what VTK will draw (polydata points through the actor's full
-matrix). The sync's own bookkeeping is never read. Every check looks at every frame it runs.
+with forward kinematics); read-back is what the renderer will draw (FURY 0.12: polydata points through
+the actor's full matrix; FURY 2: ``geometry.positions`` through ``actor.world.matrix``). The sync's own bookkeeping is never read. Every check looks at every frame it runs.
 """
 
 from __future__ import annotations

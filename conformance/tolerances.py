@@ -2,8 +2,8 @@
 
 A correct sync makes two kinds of error, and the tolerance allows for both, no more:
 
-* float32 vertex storage: VTK keeps FURY's sphere vertices (and any array a sync writes back) in
-  float32, whose rounding is at most 2⁻²⁴ of the coordinate; we allow 4× that of the largest world
+* float32 vertex storage: FURY 0.12 keeps its sphere vertices, FURY 2 every vertex (and any array a
+  sync writes back) in float32, whose rounding is at most 2⁻²⁴ of the coordinate; we allow 4× that of the largest world
   coordinate of the body (``POSITION_RTOL`` × distance from the origin + size);
 * pybullet's float32 quaternion helpers (``getMatrixFromQuaternion``, ``getDifferenceQuaternion``,
   ``multiplyTransforms``…) are off by up to ~4e-6 (pybullet-facts.md, "Quaternions"), which moves a

@@ -26,8 +26,8 @@ from dataclasses import dataclass, field
 from conformance import survey
 from conformance.progress import progress
 
-__all__ = ["Outcome", "check", "check_all", "command", "implementations", "kill_rate_table", "record_kinds",
-           "verdict_tables", "what_it_is"]
+__all__ = ["Outcome", "check", "check_all", "command", "implementations", "kill_rate_beside", "kill_rate_table", "load_run",
+           "record_kinds", "save_run", "verdicts_beside", "verdict_tables", "what_it_is"]
 
 
 @dataclass
@@ -227,6 +227,84 @@ def kill_rate_table(wrong: list[Outcome], right: list[Outcome], summaries: dict[
         first = o.failed[0] if o.failed else None
         lines.append(f"| `{o.spec}` | {summaries.get(o.spec, 'right')} | {'passed' if o.passed else 'REJECTED'} | "
                      f"{first['check'] + ' [' + str(first['scene']) + ']' if first else ''} |")
+    return "\n".join(lines)
+
+
+# -- one backend's run kept, and two backends side by side -------------------------------------------
+
+def save_run(path: str, outcomes: list[Outcome], summaries: dict[str, str] | None = None) -> None:
+    """Keep a run's outcomes as JSON, with the backend that made them, to be put beside another
+    backend's (:func:`verdicts_beside`, :func:`kill_rate_beside`): the backends are two environments,
+    so one process never has both."""
+    from conformance import backends
+    from conformance.files import write_atomically
+
+    payload = {"backend": backends.NAME, "fury": backends.fury_version(), "summaries": summaries or {},
+               "outcomes": [{"spec": o.spec, "exitstatus": o.exitstatus, "records": o.records, "stderr": o.stderr[-2000:]}
+                            for o in outcomes]}
+    write_atomically(path, json.dumps(payload, indent=1, default=float).encode("utf-8"))
+
+
+def load_run(path: str) -> tuple[str, list[Outcome], dict[str, str]]:
+    """``(label, outcomes, summaries)`` of a run kept by :func:`save_run`; the label names its FURY."""
+    from conformance.errors import ConformanceError
+
+    try:
+        payload = json.loads(open(path, encoding="utf-8").read())
+        outcomes = [Outcome(o["spec"], int(o["exitstatus"]), o["records"], o.get("stderr", "")) for o in payload["outcomes"]]
+        return f"FURY {payload['fury']} ({payload['backend']})", outcomes, payload.get("summaries", {})
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        raise ConformanceError(f"--beside {path}: not a run kept by --json ({type(exc).__name__}: {exc}); make it with "
+                               "the same command and --json in the other backend's environment") from None
+
+
+def current_label() -> str:
+    from conformance import backends
+
+    return f"FURY {backends.fury_version()} ({backends.NAME})"
+
+
+def verdicts_beside(runs: list[tuple[str, list[Outcome]]]) -> str:
+    """Markdown: scenes × implementations, each cell the verdict on every backend, labelled."""
+    specs = list(dict.fromkeys(o.spec for _, outcomes in runs for o in outcomes))
+    scenes = sorted({r["scene"] for _, outcomes in runs for o in outcomes for r in o.records if r["scene"]}, key=_scene_order)
+    lines = ["| scene | " + " | ".join(f"`{s}`" for s in specs) + " |", "|---|" + "---|" * len(specs)]
+    for scene in scenes:
+        row = []
+        for spec in specs:
+            cells = []
+            for label, outcomes in runs:
+                records = [r for o in outcomes if o.spec == spec for r in o.records if r["scene"] == scene]
+                cells.append(f"**{label.split(' (')[0]}**: {_cell(records)}")
+            row.append("<br>".join(cells))
+        lines.append(f"| {scene} | " + " | ".join(row) + " |")
+    return "\n".join(lines)
+
+
+def kill_rate_beside(runs: list[tuple[str, list[Outcome], list[Outcome]]], summaries: dict[str, str]) -> str:
+    """Markdown: the kill rate of every backend, then each implementation's verdict on each, side by side."""
+    head = [f"{label}: {sum(bool(o.failed) for o in wrong)}/{len(wrong)} wrong implementations rejected, "
+            f"{sum(o.passed for o in right)}/{len(right)} right ones accepted." for label, wrong, right in runs]
+    labels = [label.split(" (")[0] for label, _, _ in runs]
+    lines = ["Kill rate: " + " ".join(head), "",
+             "| implementation | what it is | " + " | ".join(labels) + " |", "|---|---|" + "---|" * len(runs)]
+    specs = list(dict.fromkeys(o.spec for _, wrong, right in runs for o in wrong + right))
+    for spec in specs:
+        cells = []
+        for _, wrong, right in runs:
+            mine = [o for o in wrong if o.spec == spec]
+            theirs = [o for o in right if o.spec == spec]
+            if mine:
+                first = mine[0].failed[0] if mine[0].failed else None
+                verdict = "killed" if first else ("ERROR" if mine[0].exitstatus not in (0, 1) else "**survived**")
+            elif theirs:
+                first = theirs[0].failed[0] if theirs[0].failed else None
+                verdict = "passed" if theirs[0].passed else "**REJECTED**"
+            else:
+                cells.append("–")
+                continue
+            cells.append(verdict + (f": {first['check']} [{first['scene']}]" if first else ""))
+        lines.append(f"| `{spec}` | {summaries.get(spec, '')} | " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
 

@@ -71,10 +71,10 @@ def test_gif_has_one_picture_per_chosen_frame_at_the_asked_size(tmp_path):
 
 
 def test_wrong_sync_gets_its_failing_frames_marked(tmp_path):
-    """``guide-actor`` fails ``tumbling``: every pictured frame it fails has the red border, and the
-    reference sync's pictures of the same frames have none."""
+    """``wrong_syncs:TransposedRotation`` fails ``tumbling``: every pictured frame it fails has the red
+    border, and the reference sync's pictures of the same frames have none."""
     argv = ["render", "tumbling", "--frames", "0:20:10", "--size", "200", "150"]
-    status, out, err = _render([*argv, "--sync", "guide-actor", "--gif", "bad.gif"], tmp_path)
+    status, out, err = _render([*argv, "--sync", "wrong_syncs:TransposedRotation", "--gif", "bad.gif"], tmp_path)
     assert status == 1, out + err
     failing = _failing_frames(out)
     assert failing, out
@@ -112,7 +112,7 @@ def test_frames_that_pass_and_frames_that_fail_in_one_animation(tmp_path):
 
 def test_a_failure_s_reproduce_line_becomes_an_animation(tmp_path):
     spec = scenes.get("free_fall")
-    line = reproduce_command("free_fall", "guide-actor", 4, dict(spec.defaults))
+    line = reproduce_command("free_fall", "wrong_syncs:TransposedRotation", 4, dict(spec.defaults))
     words = shlex.split(line)
     assert words[:4] == ["python", "-m", "conformance", "check"]
     status, out, err = _render(["render", *words[4:], "--gif", "repro.gif", "--size", "96", "64"], tmp_path)

@@ -91,13 +91,20 @@ def test_floor_reads_every_pose_once_and_touches_every_actor(monkeypatch, shared
         monkeypatch.setattr(pybullet, "getBasePositionAndOrientation",
                             lambda body, physicsClientId: reads.append(body) or real(body, physicsClientId=physicsClientId))
         before = {name: backends.content_state(a)[0] for name, a in drawing.actors.items()}
+        poses_before = {name: _pose_stamp(a) for name, a in drawing.actors.items()}
         sync()
         assert sorted(reads) == sorted(t.body for t in drawing.targets)
         for name, actor in drawing.actors.items():
             if shared:
-                assert backends.content_state(actor)[0] > before[name]  # Modified() after the write
+                assert backends.content_state(actor)[0] > before[name]  # Modified()/update_full() after the write
             else:
-                assert actor.GetUserMatrix() is not None
+                assert _pose_stamp(actor) != poses_before[name]  # the one call per whole actor
+
+
+def _pose_stamp(actor):
+    """What a sync's pose write on a whole actor changes: on FURY 0.12 its user matrix (None until a
+    sync gives it one); on FURY 2 when its transform last changed (``actor.local.last_modified``, ns)."""
+    return actor.GetUserMatrix() if backends.NAME == "vtk" else actor.local.last_modified
 
 
 # -- sync figures and targets ----------------------------------------------------------------------
@@ -128,7 +135,10 @@ def test_the_vertex_check_tells_right_syncs_from_wrong_ones(figures):
     wrong = {(f.name, f.style, f.bodies): f.wrong for f in figures if f.wrong is not None}
     assert all(wrong["reference", s, n] == 0 for s in syncs.STYLES for n in (3, 12))
     assert all(wrong[f"{HERE}:idle_sync", s, n] == n for s in syncs.STYLES for n in (3, 12))
-    assert wrong["guide-actor", "whole", 12] == 12  # SetOrientation's Euler angles turn the wrong way
+    if backends.NAME == "vtk":
+        assert wrong["guide-actor", "whole", 12] == 12  # SetOrientation's Euler angles turn the wrong way
+    else:
+        assert wrong["guide-actor", "whole", 12] == 0  # FURY 2's local.rotation takes pybullet's quaternion as it is
 
 
 def _verdicts(figures, subject):
@@ -183,25 +193,29 @@ def test_targets_pass_and_miss_on_the_numbers_and_say_when_the_floor_is_the_limi
 
 def test_bench_prints_tables_writes_json_and_fills_the_readme_block(tmp_path, capsys):
     readme = tmp_path / "README.md"
-    readme.write_text("# x\n\n<!-- conformance:bench -->\nold\n<!-- /conformance:bench -->\nafter\n", encoding="utf-8")
+    block = bench_command._block()  # "bench" on FURY 0.12, "bench-pygfx" on FURY 2
+    readme.write_text(f"# x\n\n<!-- conformance:{block} -->\nold\n<!-- /conformance:{block} -->\nafter\n", encoding="utf-8")
     out = tmp_path / "bench.json"
     status = cli.main(["bench", "--sizes", "3", "6", "--repeats", "1", "--only", "syncs", "reads",
                        "--json", str(out), "--readme", str(readme)])
     assert status == 0
     text = capsys.readouterr().out
-    for expected in (_machine()["cpu"], "cores (", "pybullet 3.2", "VTK 9.3", "Python 3.",
+    for expected in (_machine()["cpu"], "cores (", "pybullet 3.2", backends.describe(), "Python 3.",
                      "| one shared actor | **floor** |", "| whole actors | `reference` |", "`guide-actor`",
                      "`guide-vertex`", "`stepSimulation()`", "**Targets**", "**Reading poses**", "`getLinkStates("):
         assert expected in text, expected
+    assert floor.DEFINITION in text  # the floor of the backend in force, and its own whole-actor writes read
+    assert ("`vtkMatrix4x4.DeepCopy(" if backends.NAME == "vtk" else "`actor.local.matrix = M`") in text
     assert "**pass**" in text or "**miss**" in text
     data = json.loads(out.read_text(encoding="utf-8"))
     assert data["machine"]["pybullet"].startswith("3.2") and data["options"]["sizes"] == [3, 6]
+    assert data["machine"]["backend"] == backends.NAME and data["machine"]["fury"].startswith(("0.12", "2."))
     assert {f["name"] for f in data["syncs"]} >= {"floor", "reference", "guide-actor", "guide-vertex", "stepSimulation()"}
     assert all(f["ratio"] == pytest.approx(f["seconds"] / f["floor"]) for f in data["syncs"])
     assert data["targets"] and all(isinstance(t["passed"], bool) for t in data["targets"])
     assert data["reads"][0]["ratio"] == pytest.approx(1.0)
     block = readme.read_text(encoding="utf-8")
-    assert "old" not in block and "**Targets**" in block and block.endswith("<!-- /conformance:bench -->\nafter\n")
+    assert "old" not in block and "**Targets**" in block and block.endswith(f"<!-- /conformance:{bench_command._block()} -->\nafter\n")
 
 
 def test_bench_refuses_bad_options_before_measuring(tmp_path, capsys):
@@ -212,7 +226,7 @@ def test_bench_refuses_bad_options_before_measuring(tmp_path, capsys):
     readme.write_text("no markers\n", encoding="utf-8")
     started = time.perf_counter()
     assert cli.main(["bench", "--readme", str(readme)]) == 2
-    assert "needs one line '<!-- conformance:bench -->'" in capsys.readouterr().err
+    assert f"needs one line '<!-- conformance:{bench_command._block()} -->'" in capsys.readouterr().err
     assert time.perf_counter() - started < 5  # refused at once, not after the default run's minute
     with pytest.raises(ValueError, match="bogus"):
         Options(parts=("bogus",))

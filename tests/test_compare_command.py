@@ -7,9 +7,9 @@ import re
 
 import numpy as np
 import pytest
-from fury import utils
 
-from conformance import cli
+import actor_data
+from conformance import backends, cli
 from conformance.implementations.reference import ReferenceSync
 
 
@@ -39,8 +39,8 @@ class WritesNaNFromFrame2(ReferenceSync):
         self.calls += 1
         if self.calls >= 3:
             t = self.world.targets[0]
-            utils.vertices_from_actor(t.actor)[t.start] = np.nan
-            utils.update_actor(t.actor)
+            actor_data.vertices(t.actor)[t.start] = np.nan
+            actor_data.announce(t.actor)
 
 
 def compare(capsys, *args):
@@ -100,12 +100,12 @@ def test_nan_written_is_named_with_its_first_frame(capsys):
     assert "free_fall (non-finite, 'body', frame 2)" in out
 
 
-def test_pictures_and_changes_vtk_was_not_told_of(capsys):
+def test_pictures_and_changes_the_renderer_was_not_told_of(capsys):
     status, out, _ = compare(capsys, "reference", "wrong_syncs:ForgetsModified", "brick_wall_single", "--frames", "5",
                              "--image")
     assert status == 1
-    assert re.search(r"B \('wrong_syncs:ForgetsModified'\) changed vertex data without Modified\(\)/utils.update_actor "
-                     r"in 5 sync calls \(first: actor 'bricks' at frame 1\)", out)
+    assert re.search(r"B \('wrong_syncs:ForgetsModified'\) changed vertex data without " + re.escape(backends.ANNOUNCE) +
+                     r" in 5 sync calls \(first: actor 'bricks' at frame 1\)", out)
     assert re.search(r"pictures at frame 5: differ beyond the same-renderer tolerance: same-renderer: "
                      r"differing_fraction [\d.e-]+ > 0.00023 \(\d+ pixels differ", out)
 

@@ -1,4 +1,5 @@
-"""The README's complete example is a right sync implementation: copied out verbatim, it passes."""
+"""The README's complete example for the backend in force is a right sync implementation: copied out
+verbatim, it passes (FURY 0.12: ``my_sync.py``; FURY 2: ``my_sync_fury2.py``)."""
 
 from __future__ import annotations
 
@@ -9,19 +10,21 @@ import tempfile
 from pathlib import Path
 
 import background
+from conformance import backends
 from conformance.display import child_environment, dies_with_this_process
 
 README = Path(__file__).resolve().parent.parent / "README.md"
+MODULE = {"vtk": "my_sync", "pygfx": "my_sync_fury2"}[backends.NAME]
 
 
 def _check_the_example() -> subprocess.CompletedProcess:
     text = README.read_text(encoding="utf-8")
-    example = re.search(r"Save as `my_sync.py`.*?```python\n(.*?)```", text, re.S).group(1)
+    example = re.search(rf"Save as `{MODULE}.py`.*?```python\n(.*?)```", text, re.S).group(1)
     with tempfile.TemporaryDirectory() as where:
-        (Path(where) / "my_sync.py").write_text(example, encoding="utf-8")
+        (Path(where) / f"{MODULE}.py").write_text(example, encoding="utf-8")
         return subprocess.run(
             [sys.executable, "-m", "pytest", "--pyargs", "conformance", "-m", "sync", "-q", "-p", "no:cacheprovider",
-             "--sync", "my_sync:MySync"],
+             "--sync", f"{MODULE}:MySync"],
             cwd=where, capture_output=True, text=True, env=child_environment(),
             preexec_fn=dies_with_this_process(waited_for=True))
 

@@ -93,9 +93,9 @@ def test_render_command_writes_the_png(tmp_path, capsys):
 
 def test_check_command_exit_codes(capsys):
     assert cli.main(["check", "free_fall", "--sync", "reference", "--frames", "5"]) == 0
-    assert cli.main(["check", "free_fall", "--sync", "guide-actor", "--frames", "5"]) == 1
+    assert cli.main(["check", "free_fall", "--sync", "wrong_syncs:TransposedRotation", "--frames", "5"]) == 1
     out = capsys.readouterr().out
-    assert "PASS free_fall" in out and "FAIL free_fall with sync 'guide-actor': first failure at frame 0" in out
+    assert "PASS free_fall" in out and "FAIL free_fall with sync 'wrong_syncs:TransposedRotation': first failure at frame 0" in out
 
 
 def test_command_line_errors_are_one_line(capsys):

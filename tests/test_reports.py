@@ -40,6 +40,37 @@ def test_verdict_table_marks_passes_with_the_worst_error_and_failures_with_their
             "1 scene (chain): x is off [chain, frame 3, sync 'w']") in table
 
 
+def test_a_kept_run_comes_back_with_its_backend_and_sits_beside_this_ones(tmp_path):
+    """``--json`` keeps a run with the FURY that made it; ``--beside`` puts it next to this backend's,
+    every cell naming its FURY, and a survivor on one backend stands out in the kill-rate table."""
+    from conformance import backends
+
+    kept = tmp_path / "other.json"
+    mine = [verdicts.Outcome("w:Caught", 1, [_record("test_a", "chain", "failed")]),
+            verdicts.Outcome("r:Good", 0, [_record("test_a", "chain", "passed", 0.5)])]
+    verdicts.save_run(str(kept), mine, {"w:Caught": "wrong", "r:Good": "right"})
+    label, outcomes, roles = verdicts.load_run(str(kept))
+    assert label == f"FURY {backends.fury_version()} ({backends.NAME})"
+    assert [(o.spec, o.exitstatus, o.records) for o in outcomes] == [(o.spec, o.exitstatus, o.records) for o in mine]
+    assert roles == {"w:Caught": "wrong", "r:Good": "right"}
+    survived = [verdicts.Outcome("w:Caught", 0, [_record("test_a", "chain", "passed")])]
+    table = verdicts.kill_rate_beside([("FURY 0.12.0 (vtk)", outcomes[:1], outcomes[1:]),
+                                       ("FURY 2.0.0 (pygfx)", survived, outcomes[1:])], {"w:Caught": "forgets"})
+    assert table.startswith("Kill rate: FURY 0.12.0 (vtk): 1/1 wrong implementations rejected, 1/1 right ones accepted. "
+                            "FURY 2.0.0 (pygfx): 0/1 wrong implementations rejected")
+    assert "| `w:Caught` | forgets | killed: test_a [chain] | **survived** |" in table
+    assert "| `r:Good` |  | passed | passed |" in table
+    scenes = verdicts.verdicts_beside([("FURY 0.12.0 (vtk)", outcomes), ("FURY 2.0.0 (pygfx)", survived)])
+    assert "| chain | **FURY 0.12.0**: ✗ 1/1: test_a from frame 3<br>**FURY 2.0.0**: ✓ | **FURY 0.12.0**: ✓ 5.0e-07 m (0.5×tol)<br>**FURY 2.0.0**: – |" in scenes
+
+
+def test_a_file_that_is_not_a_kept_run_is_one_clear_error(tmp_path):
+    bad = tmp_path / "verdicts.md"
+    bad.write_text("| scene |", encoding="utf-8")
+    with pytest.raises(ConformanceError, match=r"--beside .*verdicts.md: not a run kept by --json .*in the other backend's environment"):
+        verdicts.load_run(str(bad))
+
+
 def test_implementations_are_the_modules_public_list():
     assert verdicts.implementations("right_syncs")[:2] == ["right_syncs:IncrementalSync", "right_syncs:PerTargetSync"]
     assert "right_syncs:vectorised_vertex_sync" in verdicts.implementations("right_syncs")
@@ -48,7 +79,7 @@ def test_implementations_are_the_modules_public_list():
 def test_what_an_implementation_is_comes_from_its_docstring():
     assert verdicts.what_it_is("wrong_syncs:VelocityGated") == (
         'after the first frame, skips bodies whose velocity is exactly zero ("a body at rest has not moved")')
-    assert verdicts.what_it_is("right_syncs:UserMatrixSync").startswith("per-actor user matrices")
+    assert verdicts.what_it_is("right_syncs:UserMatrixSync").startswith("per-actor ")  # user matrices or local.matrix
 
 
 def test_tables_replace_only_their_block_of_the_readme(tmp_path):
@@ -99,6 +130,10 @@ def test_verdicts_runs_in_survey_mode_and_kill_rate_stops_at_the_first_failure(m
     assert calls.pop()["survey"] is True
     assert cli.main(["kill-rate", "--wrong", "wrong_syncs", "--right", "right_syncs"]) == 1  # nothing killed here
     assert [c.get("survey", False) for c in calls] == [False, False] and calls[0]["stop_at_first"] is True
+    from conformance import backends
+
+    out = capsys.readouterr().out  # both tables say which FURY they were made on
+    assert out.count(f"Checked on the {backends.describe()}.") == 2
 
 
 def test_verdicts_refuses_a_spec_that_does_not_load_before_running_anything(monkeypatch, capsys):

@@ -131,15 +131,15 @@ def test_step_that_raises_names_the_step(pytester):
 def test_sync_writing_nan_fails_with_non_finite_message(pytester):
     _write(pytester, "sync_i", """
         import numpy as np
-        from fury import utils
+        import actor_data
 
         class Sync:
             def __init__(self, world):
                 self.world = world
             def __call__(self):
                 for t in self.world.targets:
-                    utils.vertices_from_actor(t.actor)[t.start:t.stop] = np.nan
-                    utils.update_actor(t.actor)
+                    actor_data.vertices(t.actor)[t.start:t.stop] = np.nan
+                    actor_data.announce(t.actor)
     """)
     result = pytester.runpytest(*RUN, "--sync", "sync_i:Sync")
     _assert_one_paragraph_failure(result, "is drawn at non-finite coordinates", "[free_fall(", "reproduce: python -m conformance check free_fall --sync sync_i:Sync")

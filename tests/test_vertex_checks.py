@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from conformance import compare, sync
+from conformance import backends, compare, sync
 from conformance import test_vertices as checks
 from conformance.events import Teleport
 from conformance.pytest_helpers import Kit
@@ -27,13 +27,19 @@ def kit(spec: str) -> Kit:
     return Kit(sync.load(spec), DEFAULT)
 
 
-@pytest.mark.parametrize("spec", ["wrong_syncs:DoesNothing", "wrong_syncs:TransposedRotation", "guide-actor"])
+#: The guide's actor recipe is wrong on FURY 0.12 (SetOrientation's Euler order) and right on FURY 2,
+#: whose port assigns pyBullet's quaternion as it is (``local.rotation = orn``).
+GUIDE_ACTOR_WRONG = backends.NAME == "vtk"
+
+
+@pytest.mark.parametrize("spec", ["wrong_syncs:DoesNothing", "wrong_syncs:TransposedRotation",
+                                  *(["guide-actor"] if GUIDE_ACTOR_WRONG else [])])
 def test_every_frame_check_fails_on_a_wrong_pose(spec):
     with pytest.raises(Failed, match=r"is drawn at .* but should be at .*\[free_fall\(.*frame \d+.*\nreproduce: "):
         checks.test_vertices_match_poses_every_frame("free_fall", kit(spec))
 
 
-@pytest.mark.parametrize("spec", ["reference", "right_syncs:UserMatrixSync"])
+@pytest.mark.parametrize("spec", ["reference", "right_syncs:UserMatrixSync", *([] if GUIDE_ACTOR_WRONG else ["guide-actor"])])
 def test_every_frame_check_passes_a_right_sync(spec):
     checks.test_vertices_match_poses_every_frame("free_fall", kit(spec))
 
@@ -81,6 +87,16 @@ def test_bounds_check_fails_on_inflated_bodies():
         checks.test_drawn_bounds_agree_with_get_aabb("free_fall", kit("wrong_syncs:InflatedAgainstZFighting"))
 
 
+def test_bounds_check_bites_on_spheres():
+    """Spheres are meshes on both FURYs (FURY 2's default ``actor.sphere`` is an impostor, six vertices at
+    the centre, which no bounds check could hold to a radius): a ball drawn 0.1 % too large sticks out."""
+    for spec, inflated in (("wrong_syncs:InflatedAgainstZFighting", True), ("reference", False)):
+        with kit(spec).run("bouncing_ball") as run:
+            run.advance(30)  # in the air, turned
+            ball = next(r for r in compare.compare_bounds(run.drawing, run.frame) if r.target == "ball")
+        assert any("sticks out of getAABB" in p for p in ball.problems) == inflated, (spec, ball.problems)
+
+
 def test_bounds_check_fails_on_shrunk_bodies_even_where_get_aabb_is_loose():
     """Cylinders and bodies off their centre of mass, for which pybullet's box is larger than the shape."""
     import wrong_syncs
@@ -110,3 +126,26 @@ def test_normals_check_fails_when_shared_sphere_normals_stay_put():
 def test_modified_check_fails_when_changes_are_not_announced():
     with pytest.raises(Failed, match=r"actor 'bricks': the sync changed its vertex data at frame \d+ without marking it modified"):
         checks.check_run(kit("wrong_syncs:ForgetsModified"), "brick_wall_single", {}, 2)
+
+
+def test_each_frame_is_judged_on_its_own_announcement():
+    """The renderer is handed each frame's announced changes, as a live window's next frame is: a sync
+    that announces its rewrites at frames 1 and 2 only is caught at frames 0 and 3, and not at 2 (on
+    FURY 2, ``update_full()`` does nothing while a full upload asked for earlier is still pending, so
+    without the hand-over frame 2's announcement would look missing)."""
+    import actor_data
+
+    class AnnouncesFramesOneAndTwo:
+        def __init__(self, world):
+            self.bricks, self.frame = world.actors["bricks"], -1
+
+        def __call__(self):
+            self.frame += 1
+            actor_data.vertices(self.bricks)[:3] += 1e-3
+            if self.frame in (1, 2):
+                actor_data.announce(self.bricks)
+
+    implementation = sync.SyncImplementation(spec="twice", target="tests:AnnouncesFramesOneAndTwo", factory=AnnouncesFramesOneAndTwo)
+    with Kit(implementation, DEFAULT).run("brick_wall_single") as run:
+        run.advance(3)
+    assert [frame for frame, actor in run.unannounced if actor == "bricks"] == [0, 3]

@@ -3,21 +3,28 @@
 Most of them are ``Baseline`` (``right_syncs.PerTargetSync``, a plain, correct per-target sync) with
 one method rewritten the way a user gets it wrong, so that the mistake is the only difference and
 the kit's verdict is about that mistake alone (``PerTargetSync`` itself must pass, and
-``tests/test_discrimination.py`` checks that it does). The rest are written from scratch in the style
-they imitate (the guide's incremental vertex recipe, actor Euler angles, velocity gating).
+``tests/test_discrimination.py`` checks that it does). ``DoesNothing`` is written from scratch.
 
 Every class's docstring starts with "Wrong:" and says what the mistake is and where people make it.
+The same classes under the same names on both backends, so ``--sync wrong_syncs:<Name>`` means the
+same mistake in either environment, and the kill-rate tables line up by name. Where each lives:
+
+* here, written once: the mistakes that never touch the renderer, in a pose, a rotation matrix,
+  which targets are synced, when, or in pybullet (``Baseline`` is the backend's ``PerTargetSync``,
+  from the ``right_syncs`` dispatcher);
+* ``wrong_syncs_vtk`` (FURY 0.12) and ``wrong_syncs_pygfx`` (FURY 2), re-exported here: the mistakes
+  made through the renderer's own API (actor rotations and scales, vertex ranges, normals, colours,
+  announcing changes), each made the way a user of that FURY makes it; their renderer-free halves
+  are mixins in ``sync_steps``.
 """
 
 from __future__ import annotations
 
-from collections import defaultdict
+import importlib
 
 import numpy as np
-from fury import utils
-from scipy.spatial.transform import Rotation
-from vtkmodules.util import numpy_support
 
+from conformance import backends
 from right_syncs import PerTargetSync as Baseline  # the correct sync each mistake departs from
 
 __all__ = [
@@ -40,15 +47,27 @@ __all__ = [
     "TintsMovingBodies",
     "TransposedRotation",
     "VelocityGated",
-    "WrongVertexRange",
     "WritesPoseBack",
+    "WrongVertexRange",
 ]
+
+# ---- made through the renderer: one module per FURY -------------------------------------------------
+
+_renderer = importlib.import_module(f"wrong_syncs_{backends.NAME}")
+CentreNotUpdated = _renderer.CentreNotUpdated
+EulerRotateXYZ = _renderer.EulerRotateXYZ
+Float32Incremental = _renderer.Float32Incremental
+ForgetsModified = _renderer.ForgetsModified
+InflatedAgainstZFighting = _renderer.InflatedAgainstZFighting
+NormalsNotRotated = _renderer.NormalsNotRotated
+TintsMovingBodies = _renderer.TintsMovingBodies
+WrongVertexRange = _renderer.WrongVertexRange
 
 
 # ---- rotations ---------------------------------------------------------------------------------------
 
 class TransposedRotation(Baseline):
-    """Wrong: reads getMatrixFromQuaternion's nine numbers column-major ("VTK and OpenGL matrices are
+    """Wrong: reads getMatrixFromQuaternion's nine numbers column-major ("GPU matrices are
     column-major"), so every body is drawn with the transpose — the inverse — of its rotation."""
 
     def matrix(self, orn):
@@ -57,7 +76,8 @@ class TransposedRotation(Baseline):
 
 class QuaternionWXYZ(Baseline):
     """Wrong: unpacks pybullet's (x, y, z, w) quaternion as (w, x, y, z), the order of transforms3d,
-    Eigen's constructor and most textbooks, then uses the textbook matrix formula."""
+    Eigen's constructor and most textbooks, then uses the textbook matrix formula (pygfx's
+    ``local.rotation`` takes x, y, z, w like pybullet; the mistake is in the hand-written helper)."""
 
     def matrix(self, orn):
         w, x, y, z = orn
@@ -75,30 +95,6 @@ class ConjugateQuaternion(Baseline):
     def matrix(self, orn):
         _, inverse = self.p.invertTransform([0, 0, 0], orn)
         return np.reshape(self.p.getMatrixFromQuaternion(inverse), (3, 3))
-
-
-class EulerRotateXYZ:
-    """Wrong: resets the actor and applies pybullet's Euler angles with RotateX, RotateY, RotateZ in
-    that order. VTK's Rotate* turn about the actor's own (already turned) axes, giving Rx·Ry·Rz,
-    while getEulerFromQuaternion's angles mean Rz·Ry·Rx: right only for turns about one axis. (The
-    guide's SetOrientation recipe is the same mistake in VTK's Z-X-Y order.)"""
-
-    def __init__(self, world):
-        self.p = world.p
-        self.whole = [t for t in world.targets if not t.shared]
-        self.shared = Baseline(world)  # vertex ranges of shared actors are moved correctly
-        self.shared.targets = [t for t in world.targets if t.shared]
-
-    def __call__(self):
-        for t in self.whole:
-            pos, orn = self.shared.link_pose(t)
-            roll, pitch, yaw = np.degrees(self.p.getEulerFromQuaternion(orn))
-            t.actor.SetOrientation(0, 0, 0)
-            t.actor.RotateX(roll)
-            t.actor.RotateY(pitch)
-            t.actor.RotateZ(yaw)
-            t.actor.SetPosition(*pos)
-        self.shared()
 
 
 # ---- frames --------------------------------------------------------------------------------------------
@@ -218,150 +214,6 @@ class VelocityGated(Baseline):
         return [t for t in self.targets if self.moving(t)]
 
 
-# ---- vertices ------------------------------------------------------------------------------------------
-
-class InflatedAgainstZFighting(Baseline):
-    """Wrong: draws every body 0.1 % larger than its collision shape ("so touching bricks do not
-    z-fight"): SetScale on whole actors, scaled link-frame geometry in shared ones."""
-
-    SCALE = 1.001
-
-    def __init__(self, world):
-        super().__init__(world)
-        for name in self.local:
-            self.local[name] = self.local[name] * self.SCALE
-        for t in self.targets:
-            if not t.shared:
-                t.actor.SetScale(self.SCALE)
-
-
-class WrongVertexRange:
-    """Wrong: FURY's wrecking-ball example bug: the guide's incremental vertex recipe with the vertices
-    per object (``sec``) of every shared actor computed from the object count of the first shared
-    actor (the bricks), so the other shared actors (the chain's links) are moved by the wrong ranges."""
-
-    def __init__(self, world):
-        self.p = world.p
-        self.base = Baseline(world)
-        self.whole = [t for t in world.targets if not t.shared]
-        by_actor = defaultdict(list)
-        for t in world.targets:
-            if t.shared:
-                by_actor[id(t.actor)].append(t)
-        self.groups = []
-        num_objects = None
-        for members in by_actor.values():
-            vertices = utils.vertices_from_actor(members[0].actor)
-            if num_objects is None:
-                num_objects = len(members)  # the example's brick_centers.shape[0], reused for the chain
-            sec = int(vertices.shape[0] / num_objects)
-            centers = np.array([t.position for t in members])
-            orns = np.array([t.orientation for t in members])
-            self.groups.append((members[0].actor, members, sec, centers, orns))
-
-    def __call__(self):
-        p = self.p
-        for t in self.whole:
-            self.base.place_whole(t, *self.base.link_pose(t))
-        for actor, members, sec, centers, orns in self.groups:
-            vertices = utils.vertices_from_actor(actor)
-            for index, t in enumerate(members):
-                pos, orn = self.base.link_pose(t)
-                rot_mat = np.reshape(p.getMatrixFromQuaternion(p.getDifferenceQuaternion(orn, orns[index])), (3, 3))
-                vertices[index * sec: index * sec + sec] = \
-                    (vertices[index * sec: index * sec + sec] - centers[index]) @ rot_mat + pos
-                centers[index] = pos
-                orns[index] = orn
-            utils.update_actor(actor)
-
-
-class CentreNotUpdated:
-    """Wrong: the guide's incremental single-actor recipe (turn each vertex range about its tracked
-    centre by the rotation since last frame, then move it to the new centre) that updates the tracked
-    orientation but forgets ``brick_centers[i] = pos``: every frame turns about a stale centre."""
-
-    def __init__(self, world):
-        self.p = world.p
-        self.base = Baseline(world)
-        self.shared = [t for t in world.targets if t.shared]
-        self.whole = [t for t in world.targets if not t.shared]
-        self.centers = {t.name: np.array(t.position, dtype=np.float64) for t in self.shared}
-        self.orns = {t.name: np.array(t.orientation, dtype=np.float64) for t in self.shared}
-
-    def __call__(self):
-        for t in self.whole:
-            self.base.place_whole(t, *self.base.link_pose(t))
-        actors = {}
-        for t in self.shared:
-            pos, orn = self.base.link_pose(t)
-            vertices = utils.vertices_from_actor(t.actor)
-            delta = np.reshape(self.p.getMatrixFromQuaternion(self.p.getDifferenceQuaternion(orn, self.orns[t.name])), (3, 3))
-            vertices[t.start:t.stop] = (vertices[t.start:t.stop] - self.centers[t.name]) @ delta + pos
-            self.orns[t.name] = orn  # ... and no self.centers[t.name] = pos
-            actors[id(t.actor)] = t.actor
-        for actor in actors.values():
-            utils.update_actor(actor)
-
-
-class Float32Incremental:
-    """Wrong: the incremental recipe applied to every actor's vertices (and normals) in float32 (FURY
-    stores sphere vertices as float32; this keeps all its arrays so "to match VTK"): each frame's
-    rotation since the last one is rounded to float32 and applied to already rounded vertices, so the
-    error random-walks and a body that tumbles for thousands of steps is drawn off its pose."""
-
-    def __init__(self, world):
-        self.base = Baseline(world)
-        self.targets = list(world.targets)
-        self.vertices, self.normals = {}, {}
-        for t in self.targets:
-            if id(t.actor) not in self.vertices:
-                self.vertices[id(t.actor)] = np.array(utils.vertices_from_actor(t.actor), dtype=np.float32)
-                normals = t.actor.GetMapper().GetInput().GetPointData().GetNormals()
-                if normals is not None:
-                    self.normals[id(t.actor)] = numpy_support.vtk_to_numpy(normals)  # float32 already
-        self.last = {t.name: (np.array(t.position, np.float32), np.array(t.orientation, np.float32)) for t in self.targets}
-
-    def __call__(self):
-        actors = {}
-        for t in self.targets:
-            pos, orn = self.base.link_pose(t)
-            pos, orn = np.asarray(pos, np.float32), np.asarray(orn, np.float32)
-            old_pos, old_orn = self.last[t.name]
-            delta = (Rotation.from_quat(orn) * Rotation.from_quat(old_orn).inv()).as_matrix().astype(np.float32)
-            vertices = self.vertices[id(t.actor)]
-            vertices[t.start:t.stop] = (vertices[t.start:t.stop] - old_pos) @ delta.T + pos
-            if id(t.actor) in self.normals:
-                normals = self.normals[id(t.actor)]
-                normals[t.start:t.stop] = normals[t.start:t.stop] @ delta.T
-            self.last[t.name] = (pos, orn)
-            actors[id(t.actor)] = t.actor
-        for key, actor in actors.items():
-            utils.vertices_from_actor(actor)[:] = self.vertices[key]
-            utils.update_actor(actor)
-
-
-class NormalsNotRotated(Baseline):
-    """Wrong: moves the vertices of shared sphere actors but leaves their stored normals as built, so a
-    turned sphere is shaded as if lit from where the light was when it was built (VTK turns normals
-    with an actor's matrix, never with rewritten vertices)."""
-
-    def place_shared(self, t, pos, orn):
-        utils.vertices_from_actor(t.actor)[t.start:t.stop] = self.local[t.name] @ self.matrix(orn).T + pos
-
-    def finish(self, actors):
-        for actor in actors:
-            actor.GetMapper().GetInput().GetPoints().Modified()
-
-
-class ForgetsModified(Baseline):
-    """Wrong: writes the new vertices into the numpy view of the points but never calls
-    ``utils.update_actor`` / ``Modified()``: VTK does not know the points changed and goes on
-    drawing the vertices it uploaded before."""
-
-    def finish(self, actors):
-        pass
-
-
 # ---- side effects ----------------------------------------------------------------------------------
 
 class WritesPoseBack(Baseline):
@@ -376,18 +228,6 @@ class WritesPoseBack(Baseline):
                 pos, orn = self.p.getBasePositionAndOrientation(t.body)
                 self.p.resetBasePositionAndOrientation(
                     t.body, np.float32(pos).tolist(), (np.float32(orn) / np.linalg.norm(np.float32(orn))).tolist())
-
-
-class TintsMovingBodies(Baseline):
-    """Wrong: recolours shared-actor bodies by speed while syncing ("to see what moves"): the vertex
-    colours, which a sync must leave alone, change."""
-
-    def place_shared(self, t, pos, orn):
-        super().place_shared(t, pos, orn)
-        if t.link == -1:
-            speed = float(np.linalg.norm(self.p.getBaseVelocity(t.body)[0]))
-            colors = utils.colors_from_actor(t.actor)
-            colors[t.start:t.stop, :3] = [int(255 * min(speed, 1.0)), 64, 64]
 
 
 class DoesNothing:

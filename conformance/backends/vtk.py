@@ -6,57 +6,26 @@ test, being FURY code, touch them too).
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import weakref
-from collections import defaultdict
-from dataclasses import dataclass
-from typing import Any, Sequence
+from typing import Any, Iterator
 
 import numpy as np
 from vtkmodules.util import numpy_support
 
-from conformance import poses, truth
+from conformance.backends.common import Drawing, decode_ids, id_codes, lay_out, moved_range, transformed, turned_normals
 from conformance.display import close_x_connection, ensure_display, on_stop, x_connection
 from conformance.errors import SceneError
-from conformance.world import Target, World
 
-__all__ = ["Drawing", "build", "content_state", "content_time", "mesh_signature", "render", "render_ids", "renderer_info", "world_normals", "world_vertices"]
-
-IDENTITY_POSITION = np.zeros(3)
-IDENTITY_ORIENTATION = np.array([0.0, 0.0, 0.0, 1.0])
+__all__ = ["ANNOUNCE", "LIGHTING", "MULTISAMPLES", "NAME", "Drawing", "build", "content_state", "content_time", "flush", "mesh_signature", "perturbed", "render", "render_ids", "renderer_info", "world_normals", "world_vertices"]
 
 
-@dataclass(frozen=True, eq=False)
-class Drawing:
-    """A scene's actors, the :class:`World` handed to the sync, and the kit's reference geometry.
-
-    ``local[i]`` is target i's geometry in its link frame, float64, computed when the actor was built
-    (before any float32 storage): the ground truth that read-back is compared against.
-    ``local_normals[i]`` are its vertex normals in the link frame, or None where FURY stores none
-    (boxes, cylinders: VTK derives their normals from the faces).
-    """
-
-    world: World
-    local: tuple[np.ndarray, ...]
-    local_normals: tuple[np.ndarray | None, ...]
-
-    @property
-    def targets(self) -> tuple[Target, ...]:
-        return self.world.targets
-
-    @property
-    def actors(self):
-        return self.world.actors
-
-
-def _fury_actor(kind: str, shapes: Sequence[Any]):
-    """One FURY actor drawing ``shapes`` at the origin in their canonical direction."""
+def _fury_actor(kind: str, centers: np.ndarray, colors: np.ndarray, sizes: np.ndarray):
+    """One FURY 0.12 actor drawing one shape per row of ``sizes`` at the origin in its canonical direction."""
     from fury import actor as fury_actor
 
-    n = len(shapes)
-    centers = np.zeros((n, 3))
-    colors = np.array([s.color for s in shapes], dtype=np.float64)
-    sizes = np.array([s.size for s in shapes], dtype=np.float64)
+    n = len(centers)
     if kind == "box":
         # FURY's unit box spans ±0.5 and keeps its axes for direction +x.
         return fury_actor.box(centers=centers, directions=np.tile([1.0, 0, 0], (n, 1)), scales=2 * sizes, colors=colors)
@@ -83,71 +52,69 @@ def _normals(actor) -> np.ndarray | None:
     return None if normals is None else np.asarray(normals)
 
 
+def _announce(actor) -> None:
+    data = actor.GetMapper().GetInput()
+    data.GetPoints().Modified()
+    if data.GetPointData().GetNormals() is not None:
+        data.GetPointData().GetNormals().Modified()
+    data.Modified()
+
+
 def build(scene) -> Drawing:
-    """Actors for every binding of ``scene``, drawn at the poses pybullet holds now.
+    """Actors for every binding of ``scene``, drawn at the poses pybullet holds now
+    (:func:`conformance.backends.common.lay_out`), as FURY 0.12 actors."""
+    return lay_out(scene, _fury_actor, _points, _normals, _announce)
 
-    Whole actors are built at the origin with an identity transform (the guide: "Centers for the
-    actor must be set to (0, 0, 0)"); shared actors have each vertex range written at its body's
-    current link-frame pose (as the guide's single-actor example builds them from ``brick_centers``).
-    """
-    groups: dict[str, list[int]] = defaultdict(list)
-    for i, binding in enumerate(scene.bindings):
-        groups[binding.actor].append(i)
-    positions, orientations = truth.link_frames(scene.p, [(b.body, b.link) for b in scene.bindings])
 
-    actors: dict[str, Any] = {}
-    targets: list[Target | None] = [None] * len(scene.bindings)
-    local: list[np.ndarray | None] = [None] * len(scene.bindings)
-    local_normals: list[np.ndarray | None] = [None] * len(scene.bindings)
-    for name, members in groups.items():
-        shapes = [scene.bindings[i].shape for i in members]
-        kinds = {s.kind for s in shapes}
-        if len(kinds) != 1:
-            raise SceneError(f"scene {scene.name!r}: actor {name!r} would draw several shape kinds {sorted(kinds)}")
-        actor = _fury_actor(kinds.pop(), shapes)
-        points = _points(actor)
-        normals = _normals(actor)
-        per_body, remainder = divmod(len(points), len(members))
-        if remainder:
-            raise SceneError(f"scene {scene.name!r}: actor {name!r} has {len(points)} vertices for {len(members)} bodies")
-        shared = len(members) > 1
-        for k, i in enumerate(members):
-            start, stop = k * per_body, (k + 1) * per_body
-            shape = scene.bindings[i].shape
-            geometry = poses.apply(shape.position, shape.orientation, points[start:stop])
-            if shared:
-                drawn_pos, drawn_orn = positions[i], orientations[i]
-            else:
-                drawn_pos, drawn_orn = IDENTITY_POSITION, IDENTITY_ORIENTATION
-            points[start:stop] = poses.apply(drawn_pos, drawn_orn, geometry)
-            local[i] = geometry
-            if normals is not None:
-                # Normals turn with the body, or a rotated sphere is shaded as if lit from elsewhere.
-                local_normals[i] = np.asarray(normals[start:stop], dtype=np.float64) @ poses.matrices(shape.orientation).T
-                normals[start:stop] = local_normals[i] @ poses.matrices(drawn_orn).T
-            targets[i] = Target(
-                name=scene.bindings[i].name, body=scene.bindings[i].body, link=scene.bindings[i].link,
-                actor=actor, start=start, stop=stop, shared=shared,
-                position=np.array(drawn_pos, dtype=np.float64), orientation=np.array(drawn_orn, dtype=np.float64),
-            )
-        actor.GetMapper().GetInput().GetPoints().Modified()
-        if normals is not None:
-            actor.GetMapper().GetInput().GetPointData().GetNormals().Modified()
-        actor.GetMapper().GetInput().Modified()
-        actors[name] = actor
+def flush(drawing: Drawing) -> None:
+    """Nothing to hand over between frames: VTK compares modification times when it draws."""
 
-    world = World(scene=scene.name, p=scene.p, targets=tuple(targets), actors=actors)
-    return Drawing(world=world, local=tuple(local), local_normals=tuple(local_normals))
+
+@contextlib.contextmanager
+def perturbed(target, *, transform: np.ndarray | None = None, recolour=None) -> Iterator[None]:
+    """Within the block, ``target`` is drawn moved by the world ``transform`` (4x4) or with its vertex
+    colours mapped by ``recolour`` ((n, 3) floats in 0..1 to the same); restored on exit. For measuring
+    what the image checks see (:mod:`conformance.rendering.measure_tolerances`), not for checks."""
+    from vtkmodules.vtkCommonMath import vtkMatrix4x4
+
+    t = target
+    data = t.actor.GetMapper().GetInput()
+    if recolour is not None:
+        # FURY's spheres colour by the "colors" point array (their active scalars are something
+        # else); boxes and cylinders have it as the active scalars.
+        scalars = data.GetPointData().GetArray("colors") or data.GetPointData().GetScalars()
+        colours = numpy_support.vtk_to_numpy(scalars)
+        saved = colours.copy()
+        shifted = recolour(colours[t.start:t.stop, :3].astype(float) / 255)
+        colours[t.start:t.stop, :3] = np.round(shifted * 255).astype(colours.dtype)
+        scalars.Modified()
+        data.Modified()
+        try:
+            yield
+        finally:
+            colours[:] = saved
+            scalars.Modified()
+            data.Modified()
+        return
+    if not t.shared:
+        before = t.actor.GetUserMatrix()
+        user = np.eye(4) if before is None else np.array([[before.GetElement(r, c) for c in range(4)] for r in range(4)])
+        matrix = vtkMatrix4x4()
+        matrix.DeepCopy((transform @ user).ravel().tolist())  # the world transform after the user matrix
+        t.actor.SetUserMatrix(matrix)
+        try:
+            yield
+        finally:
+            t.actor.SetUserMatrix(before)
+        return
+    with moved_range(t, transform, _points(t.actor), _normals(t.actor), lambda: _announce(t.actor)):
+        yield
 
 
 def world_vertices(actor) -> np.ndarray:
     """The actor's vertices as VTK will draw them: polydata points through ``actor.GetMatrix()``,
     which composes position, orientation, origin, scale, user matrix and user transform."""
-    points = np.asarray(_points(actor), dtype=np.float64)
-    matrix = _matrix(actor)
-    homogeneous = points @ matrix[:3, :3].T + matrix[:3, 3]
-    w = points @ matrix[3, :3] + matrix[3, 3]
-    return homogeneous / w[:, None]
+    return transformed(_points(actor), _matrix(actor))
 
 
 def _matrix(actor) -> np.ndarray:
@@ -164,9 +131,7 @@ def world_normals(actor) -> np.ndarray | None:
     normals = _normals(actor)
     if normals is None:
         return None
-    linear = _matrix(actor)[:3, :3]
-    turned = np.asarray(normals, dtype=np.float64) @ np.linalg.inv(linear)
-    return turned / np.linalg.norm(turned, axis=1, keepdims=True)
+    return turned_normals(normals, _matrix(actor))
 
 
 def content_time(actor) -> int:
@@ -197,6 +162,14 @@ def mesh_signature(actor) -> tuple[int, str, str]:
     color_digest = hashlib.sha1(numpy_support.vtk_to_numpy(colors).tobytes()).hexdigest() if colors is not None else ""
     return data.GetNumberOfPoints(), cells.hexdigest(), color_digest
 
+
+NAME = "vtk"
+
+#: What tells the renderer that vertex data changed, as failure messages name it.
+ANNOUNCE = "Modified()/utils.update_actor"
+
+#: How every picture is lit, as the golden manifests say.
+LIGHTING = "VTK's default headlight (follows the camera)"
 
 #: Anti-aliasing samples of every picture unless a caller asks otherwise.
 MULTISAMPLES = 8
@@ -322,29 +295,6 @@ def renderer_info() -> dict[str, str]:
 
 # -- the flat ID render (the silhouette check) ------------------------------------------------------
 
-def id_colors(count: int) -> np.ndarray:
-    """The ``(count, 3)`` uint8 colour of each target index in :func:`render_ids`: ``index + 1`` times a
-    stride spreading the codes over the 24-bit colour cube (black, code 0, is the background), so that
-    no two are neighbours and a blended pixel is almost never another target's colour."""
-    stride = max(1, (2**24 - 1) // (count + 1))
-    values = (np.arange(count, dtype=np.int64) + 1) * stride
-    return np.stack([(values >> 16) & 255, (values >> 8) & 255, values & 255], axis=1).astype(np.uint8)
-
-
-def decode_ids(picture: np.ndarray, count: int) -> np.ndarray:
-    """``(h, w)`` int32 target index of each pixel of an ID ``picture`` (-1 for the background).
-
-    Raises ``RuntimeError`` if any pixel is neither the background nor exactly a target's colour:
-    the renderer blended (anti-aliasing, lighting, translucency), and the picture cannot be trusted."""
-    stride = max(1, (2**24 - 1) // (count + 1))
-    values = (picture[..., 0].astype(np.int64) << 16) | (picture[..., 1].astype(np.int64) << 8) | picture[..., 2]
-    index, remainder = np.divmod(values, stride)
-    bad = (remainder != 0) | (index > count)
-    if bad.any():
-        raise RuntimeError(f"ID render: {int(bad.sum())} pixels are not exactly a target's colour (blended?)")
-    return (index - 1).astype(np.int32)
-
-
 def render_ids(drawing: Drawing, camera, size: tuple[int, int]) -> np.ndarray:
     """``(height, width)`` int32: the index into ``drawing.targets`` of the target seen at each pixel,
     -1 for the background; top row first, like :func:`render`.
@@ -364,24 +314,15 @@ def render_ids(drawing: Drawing, camera, size: tuple[int, int]) -> np.ndarray:
     """
     from vtkmodules.vtkRenderingCore import vtkProperty
 
-    colors = id_colors(len(drawing.targets))
-    by_actor: dict[int, list[int]] = defaultdict(list)
-    actors = {}
-    for i, target in enumerate(drawing.targets):
-        by_actor[id(target.actor)].append(i)
-        actors[id(target.actor)] = target.actor
     restore = []
     render_window = _render_window()
     multisamples = render_window.GetMultiSamples()
     try:
-        for key, actor in actors.items():
+        for actor, codes in id_codes(drawing, lambda a: a.GetMapper().GetInput().GetNumberOfPoints()):
             mapper, data = actor.GetMapper(), actor.GetMapper().GetInput()
             scalars = data.GetPointData().GetScalars()
             saved = (actor, actor.GetProperty(), mapper.GetScalarVisibility(), mapper.GetColorMode(),
                      mapper.GetScalarMode(), scalars)
-            codes = np.zeros((data.GetNumberOfPoints(), 3), dtype=np.uint8)
-            for i in by_actor[key]:
-                codes[drawing.targets[i].start:drawing.targets[i].stop] = colors[i]
             if scalars is not None and scalars.GetDataTypeAsString() == "unsigned char" \
                     and scalars.GetNumberOfComponents() in (3, 4):
                 # Written in place, so the array object, its name and its place in the point data stay.

@@ -80,12 +80,19 @@ def run(args, extra) -> int:
     if args.json:
         write_atomically(Path(args.json), (report.as_json(results) + "\n").encode("utf-8"))
     if args.readme:
-        replace_block(args.readme, "bench", text)
+        replace_block(args.readme, _block(), text)
     return 0
 
 
+def _block() -> str:
+    """The README block of the backend in force: FURY 0.12's is ``bench``, FURY 2's ``bench-pygfx``."""
+    from conformance import backends
+
+    return "bench" if backends.NAME == "vtk" else f"bench-{backends.NAME}"
+
+
 def _check_readme(path: str) -> None:
-    start, end = "<!-- conformance:bench -->", "<!-- /conformance:bench -->"
+    start, end = f"<!-- conformance:{_block()} -->", f"<!-- /conformance:{_block()} -->"
     try:
         text = Path(path).read_text(encoding="utf-8")
     except OSError as exc:

@@ -185,10 +185,12 @@ def scene_report(result) -> str:
                          "judged against its own run's physics")
         unannounced = result.unannounced.get(side) or []
         if unannounced:
+            from conformance import backends
+
             frame, actor = unannounced[0]
-            lines.append(f"  {side} ({spec!r}) changed vertex data without Modified()/utils.update_actor in "
+            lines.append(f"  {side} ({spec!r}) changed vertex data without {backends.ANNOUNCE} in "
                          f"{len(unannounced)} sync call{'s' if len(unannounced) != 1 else ''} (first: actor {actor!r} at "
-                         f"frame {frame}): a live VTK window keeps drawing the old vertices")
+                         f"frame {frame}): a live window keeps drawing the old vertices")
     if result.physics_diverged is not None and not result.touched_physics:
         lines.append(f"  the two runs' pyBullet poses differ from frame {result.physics_diverged} on, though neither "
                      "sync call changed the state: each side is judged against its own run")
@@ -230,7 +232,7 @@ def summary(results) -> str:
             elif side in r.touched_physics:
                 where.append(f"{r.scene} (changed pyBullet's state at frame {r.touched_physics[side]})")
             elif r.unannounced.get(side):
-                where.append(f"{r.scene} (vertex data changed without Modified() from frame {r.unannounced[side][0][0]})")
+                where.append(f"{r.scene} (vertex data changed unannounced from frame {r.unannounced[side][0][0]})")
         if where:
             lines.append(f"{side} ({spec!r}) does not agree with pyBullet on {len(where)} of {len(results)} scenes: "
                          + ", ".join(where) + ".")

@@ -16,12 +16,16 @@ def add_arguments(parser) -> None:
     parser.add_argument("--right", required=True, type=argparse_type(module_name, "--right"), help="module whose classes are right sync implementations")
     parser.add_argument("--out", type=argparse_type(file_to_write, "--out"), default=None, help="also write the markdown here")
     parser.add_argument("--jobs", type=jobs, default=None, help="pytest processes at a time (default 1)")
+    parser.add_argument("--json", type=argparse_type(file_to_write, "--json"), default=None,
+                        help="also keep this run's outcomes here, to be put --beside the other backend's")
+    parser.add_argument("--beside", action="append", type=argparse_type(existing_file, "--beside"), default=[],
+                        help="a run another backend kept with --json: the README table shows both, side by side")
     parser.add_argument("--readme", type=argparse_type(existing_file, "--readme"), default=None, help="also put the table in this markdown file, between "
                         "'<!-- conformance:kill-rate -->' and '<!-- /conformance:kill-rate -->'")
 
 
 def run(args, extra) -> int:
-    from conformance import verdicts
+    from conformance import backends, verdicts
 
     wrong, right = verdicts.implementations(args.wrong), verdicts.implementations(args.right)
     # A wrong implementation needs only its first failure; a right one must pass everything.
@@ -29,7 +33,16 @@ def run(args, extra) -> int:
     accepted = verdicts.check_all(right, pytest_args=extra, jobs=args.jobs)
     summaries = {spec: verdicts.what_it_is(spec) for spec in wrong + right}
     text = verdicts.kill_rate_table(outcomes, accepted, summaries)
-    emit(text, args.out)
+    emit(f"Checked on the {backends.describe()}.\n\n{text}", args.out)  # which FURY, in every copy
+    if args.json:
+        verdicts.save_run(args.json, outcomes + accepted, {spec: ("right" if spec in right else "wrong") for spec in right + wrong})
     if args.readme:
+        if args.beside:
+            runs = []
+            for path in args.beside:
+                label, kept, roles = verdicts.load_run(path)
+                runs.append((label, [o for o in kept if roles.get(o.spec) == "wrong"], [o for o in kept if roles.get(o.spec) == "right"]))
+            runs.append((verdicts.current_label(), outcomes, accepted))
+            text = verdicts.kill_rate_beside(runs, summaries)
         replace_block(args.readme, "kill-rate", text)
     return 0 if all(o.failed for o in outcomes) and all(o.passed for o in accepted) else 1

@@ -22,18 +22,28 @@ def add_arguments(parser) -> None:
     parser.add_argument("--out", type=argparse_type(file_to_write, "--out"), default=None,
                         help="also write the markdown here")
     parser.add_argument("--jobs", type=jobs, default=None, help="pytest processes at a time (default 1)")
+    parser.add_argument("--json", type=argparse_type(file_to_write, "--json"), default=None,
+                        help="also keep this run's outcomes here, to be put --beside the other backend's")
+    parser.add_argument("--beside", action="append", type=argparse_type(existing_file, "--beside"), default=[],
+                        help="a run another backend kept with --json: the README table shows both, side by side")
     parser.add_argument("--readme", type=argparse_type(existing_file, "--readme"), default=None, help="also put the scene table in this markdown file, between "
                         "'<!-- conformance:verdicts -->' and '<!-- /conformance:verdicts -->'")
 
 
 def run(args, extra) -> int:
-    from conformance import sync, verdicts
+    from conformance import backends, sync, verdicts
 
     for spec in args.specs:  # a spec that cannot load fails now, in one paragraph, not minutes later in a table
         sync.load(spec)
     outcomes = verdicts.check_all(args.specs, survey=True, pytest_args=extra, jobs=args.jobs)
     text = verdicts.verdict_tables(outcomes)
-    emit(text, args.out)
+    emit(f"Checked on the {backends.describe()}.\n\n{text}", args.out)  # which FURY, in every copy
+    if args.json:
+        verdicts.save_run(args.json, outcomes)
     if args.readme:
-        replace_block(args.readme, "verdicts", text.split("\n\n")[0])  # the scene table
+        if args.beside:  # the scene table of every backend, this one last
+            runs = [verdicts.load_run(path)[:2] for path in args.beside] + [(verdicts.current_label(), outcomes)]
+            replace_block(args.readme, "verdicts", verdicts.verdicts_beside(runs))
+        else:
+            replace_block(args.readme, "verdicts", text.split("\n\n")[0])  # the scene table
     return 0

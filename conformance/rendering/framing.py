@@ -2,7 +2,7 @@
 
 Pictures only prove something about bodies they show: a body outside the picture, cut by its edge or
 by a clipping plane, or a few pixels across, passes any image check whatever the sync does. This check
-projects each target's world vertices (what VTK will draw, :func:`conformance.backends.world_vertices`)
+projects each target's world vertices (what the renderer will draw, :func:`conformance.backends.world_vertices`)
 through the camera (:func:`.projection.project`) and requires every vertex inside the picture and
 between the clipping planes, and the target's projected extent (the larger of its width and height on
 screen) to be at least ``min_extent`` pixels. It uses no renderer, so it says exactly which target is

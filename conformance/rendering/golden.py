@@ -42,8 +42,11 @@ _REQUIRED = ("format", "scene", "params", "frame", "camera", "size", "sync", "re
 
 
 def default_dir() -> Path:
-    """The goldens shipped with the kit (``golden/`` in a checkout, ``conformance/golden`` in a wheel)."""
-    return Path(__file__).resolve().parent.parent / "golden"
+    """The goldens shipped with the kit for the backend in force: ``golden/<backend>/`` in a checkout,
+    ``conformance/golden/<backend>/`` in a wheel (renderers differ, so each backend has its own)."""
+    from conformance import backends
+
+    return Path(__file__).resolve().parent.parent / "golden" / backends.NAME
 
 
 def paths(directory: Path | str, scene: str, frame: int) -> tuple[Path, Path]:
@@ -59,11 +62,12 @@ def regen_command(scene: str) -> str:
 
 def library_versions() -> dict[str, str]:
     versions = {}
-    for dist in ("vtk", "fury", "pybullet", "numpy"):
+    for dist in ("vtk", "fury", "pybullet", "numpy", "pygfx", "wgpu"):
         try:
             versions[dist] = md.version(dist)
         except md.PackageNotFoundError:
-            versions[dist] = "missing"
+            if dist not in ("vtk", "pygfx", "wgpu"):  # each FURY's renderer, named only where it is installed
+                versions[dist] = "missing"
     return versions
 
 

@@ -17,18 +17,14 @@ from __future__ import annotations
 
 import argparse
 import colorsys
-import contextlib
 import math
 import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
-from typing import Iterator
 
 import numpy as np
-from vtkmodules.util import numpy_support
-from vtkmodules.vtkCommonMath import vtkMatrix4x4
 
 __all__ = ["BENIGN", "ERRORS", "perturbed", "pick_target", "render_frames", "with_noise"]
 
@@ -100,21 +96,6 @@ def pick_target(run, size, *, turning: bool = False) -> int:
     return best
 
 
-def _matrix_of(actor) -> np.ndarray:
-    user = actor.GetUserMatrix()
-    if user is None:
-        return np.eye(4)
-    return np.array([[user.GetElement(r, c) for c in range(4)] for r in range(4)])
-
-
-def _set_matrix(actor, matrix: np.ndarray) -> None:
-    vtk_matrix = vtkMatrix4x4()
-    for r in range(4):
-        for c in range(4):
-            vtk_matrix.SetElement(r, c, float(matrix[r, c]))
-    actor.SetUserMatrix(vtk_matrix)
-
-
 def _rotation(axis, degrees: float) -> np.ndarray:
     axis = np.asarray(axis, float) / np.linalg.norm(axis)
     a = math.radians(degrees)
@@ -147,66 +128,27 @@ def _world_transform(run, i: int, kind: str) -> np.ndarray:
     return transform
 
 
-@contextlib.contextmanager
-def perturbed(run, i: int, kind: str) -> Iterator[None]:
-    """Within the block, target ``i`` of ``run`` is ``moved``, ``turned`` or ``recoloured``
-    (see the module docstring); everything is restored on exit."""
-    t = run.drawing.targets[i]
-    data = t.actor.GetMapper().GetInput()
+def _shift_hue(rgb: np.ndarray) -> np.ndarray:
+    """Colours (n, 3) in 0..1 with their hue turned by :data:`HUE_SHIFT`."""
+    shifted = []
+    for r, g, b in rgb:
+        h, s, v = colorsys.rgb_to_hsv(r, g, b)
+        # A grey has no hue to shift: give it some saturation so the change is a colour change.
+        shifted.append(colorsys.hsv_to_rgb((h + HUE_SHIFT) % 1.0, max(s, 0.4), max(v, 0.3)))
+    return np.array(shifted)
+
+
+def perturbed(run, i: int, kind: str):
+    """A context within which target ``i`` of ``run`` is ``moved``, ``turned`` or ``recoloured``
+    (see the module docstring); everything is restored on exit (the backend's ``perturbed``)."""
+    from conformance import backends
+
+    target = run.drawing.targets[i]
     if kind == "recoloured":
-        # FURY's spheres colour by the "colors" point array (their active scalars are something
-        # else); boxes and cylinders have it as the active scalars.
-        scalars = data.GetPointData().GetArray("colors") or data.GetPointData().GetScalars()
-        colours = numpy_support.vtk_to_numpy(scalars)
-        saved = colours.copy()
-        rgb = colours[t.start:t.stop, :3].astype(float) / 255
-        shifted = []
-        for r, g, b in rgb:
-            h, s, v = colorsys.rgb_to_hsv(r, g, b)
-            # A grey has no hue to shift: give it some saturation so the change is a colour change.
-            shifted.append(colorsys.hsv_to_rgb((h + HUE_SHIFT) % 1.0, max(s, 0.4), max(v, 0.3)))
-        colours[t.start:t.stop, :3] = np.round(np.array(shifted) * 255).astype(colours.dtype)
-        scalars.Modified()
-        data.Modified()
-        try:
-            yield
-        finally:
-            colours[:] = saved
-            scalars.Modified()
-            data.Modified()
-        return
+        return backends.perturbed(target, recolour=_shift_hue)
     if kind not in ("moved", "turned"):
         raise ValueError(f"kind={kind!r}, but should be one of {ERRORS}")
-    transform = _world_transform(run, i, kind)
-    if not t.shared:
-        before = t.actor.GetUserMatrix()
-        _set_matrix(t.actor, transform @ _matrix_of(t.actor))
-        try:
-            yield
-        finally:
-            t.actor.SetUserMatrix(before)
-        return
-    # A shared actor draws with an identity matrix: rewrite the body's own vertices (and normals).
-    points = numpy_support.vtk_to_numpy(data.GetPoints().GetData())
-    normals_array = data.GetPointData().GetNormals()
-    normals = None if normals_array is None else numpy_support.vtk_to_numpy(normals_array)
-    saved_points = points[t.start:t.stop].copy()
-    saved_normals = None if normals is None else normals[t.start:t.stop].copy()
-    points[t.start:t.stop] = saved_points @ transform[:3, :3].T + transform[:3, 3]
-    if normals is not None:
-        normals[t.start:t.stop] = saved_normals @ transform[:3, :3].T
-        normals_array.Modified()
-    data.GetPoints().Modified()
-    data.Modified()
-    try:
-        yield
-    finally:
-        points[t.start:t.stop] = saved_points
-        if normals is not None:
-            normals[t.start:t.stop] = saved_normals
-            normals_array.Modified()
-        data.GetPoints().Modified()
-        data.Modified()
+    return backends.perturbed(target, transform=_world_transform(run, i, kind))
 
 
 def with_noise(image: np.ndarray, seed: int = 0) -> np.ndarray:

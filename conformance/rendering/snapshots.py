@@ -33,12 +33,10 @@ __all__ = ["Change", "check_physics", "check_render", "make", "regenerate", "sam
 
 #: The sync whose drawing the goldens show.
 GOLDEN_SYNC = "reference"
-_RENDERER_KEYS = ("backend", "vtk", "gl_vendor", "gl_renderer", "gl_version")
-
-
 def same_renderer(made_by: dict[str, str], here: dict[str, str]) -> bool:
-    """Whether a golden was made by the renderer this machine has (same OpenGL strings and VTK)."""
-    return all(made_by.get(k) == here.get(k) for k in _RENDERER_KEYS)
+    """Whether a golden was made by the renderer this machine has: the same backend, library versions
+    and GPU (OpenGL strings for VTK, the wgpu adapter for pygfx), every key either side names."""
+    return all(made_by.get(k) == here.get(k) for k in set(made_by) | set(here))
 
 
 def tolerance_for(golden: storage.Golden, here: dict[str, str], override: str | None = None):
@@ -61,7 +59,7 @@ def manifest(run, frame: int, captured: dict[str, Any], renderer: dict[str, str]
         "camera": scene.camera.as_dict(),
         "size": list(scene.image_size),
         "background": [1.0, 1.0, 1.0],
-        "lighting": "VTK's default headlight (follows the camera)",
+        "lighting": backends.LIGHTING,
         "multisamples": backends.MULTISAMPLES,
         "sync": GOLDEN_SYNC,
         "renderer": renderer,
