@@ -111,6 +111,9 @@ def _sync_spec(config: pytest.Config) -> str:
 def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line("markers", "scene(name): the reference scene a conformance check runs on")
     config.addinivalue_line("markers", "sync: a check that runs the sync implementation under test (added automatically)")
+    # pytest-xdist registers it itself; without xdist installed the kit's grouping of a scene's checks
+    # would otherwise warn as an unknown mark in every run.
+    config.addinivalue_line("markers", "xdist_group(name): checks pytest-xdist runs in one worker (one scene's)")
     config.stash[_VERDICT_KEY] = defaultdict(lambda: defaultdict(list))
     if getattr(config.option, "dist", "no") == "load":
         # -n's default scheduling, with groups: the checks of one scene (marked below) go to one
