@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 from conformance import survey
 from conformance.progress import progress
 
-__all__ = ["Outcome", "check", "check_all", "command", "implementations", "kill_rate_beside", "kill_rate_table", "load_run",
+__all__ = ["Outcome", "check", "check_all", "command", "current_label", "implementations", "kill_rate_beside", "kill_rate_table", "load_run",
            "record_kinds", "save_run", "verdicts_beside", "verdict_tables", "what_it_is"]
 
 
@@ -232,27 +232,28 @@ def kill_rate_table(wrong: list[Outcome], right: list[Outcome], summaries: dict[
 
 # -- one backend's run kept, and two backends side by side -------------------------------------------
 
-def save_run(path: str, outcomes: list[Outcome], summaries: dict[str, str] | None = None) -> None:
+def save_run(path: str, outcomes: list[Outcome], roles: dict[str, str] | None = None) -> None:
     """Keep a run's outcomes as JSON, with the backend that made them, to be put beside another
     backend's (:func:`verdicts_beside`, :func:`kill_rate_beside`): the backends are two environments,
     so one process never has both."""
     from conformance import backends
     from conformance.files import write_atomically
 
-    payload = {"backend": backends.NAME, "fury": backends.fury_version(), "summaries": summaries or {},
+    payload = {"backend": backends.NAME, "fury": backends.fury_version(), "roles": roles or {},
                "outcomes": [{"spec": o.spec, "exitstatus": o.exitstatus, "records": o.records, "stderr": o.stderr[-2000:]}
                             for o in outcomes]}
     write_atomically(path, json.dumps(payload, indent=1, default=float).encode("utf-8"))
 
 
 def load_run(path: str) -> tuple[str, list[Outcome], dict[str, str]]:
-    """``(label, outcomes, summaries)`` of a run kept by :func:`save_run`; the label names its FURY."""
+    """``(label, outcomes, roles)`` of a run kept by :func:`save_run` (roles: spec -> "wrong"/"right" for
+    a kill-rate run); the label names its FURY."""
     from conformance.errors import ConformanceError
 
     try:
         payload = json.loads(open(path, encoding="utf-8").read())
         outcomes = [Outcome(o["spec"], int(o["exitstatus"]), o["records"], o.get("stderr", "")) for o in payload["outcomes"]]
-        return f"FURY {payload['fury']} ({payload['backend']})", outcomes, payload.get("summaries", {})
+        return f"FURY {payload['fury']} ({payload['backend']})", outcomes, payload.get("roles", {})
     except (OSError, ValueError, KeyError, TypeError) as exc:
         raise ConformanceError(f"--beside {path}: not a run kept by --json ({type(exc).__name__}: {exc}); make it with "
                                "the same command and --json in the other backend's environment") from None

@@ -26,6 +26,7 @@ one of them). The rest of the kit talks to a backend only through these names:
 
 from __future__ import annotations
 
+import functools
 import importlib
 import importlib.metadata
 
@@ -38,6 +39,7 @@ __all__ = ["ANNOUNCE", "LIGHTING", "MULTISAMPLES", "NAME", "NAMES", "Drawing", "
 NAMES = {"vtk": "FURY 0.12 (VTK)", "pygfx": "FURY 2 (pygfx/wgpu)"}
 
 
+@functools.lru_cache(maxsize=None)
 def fury_version() -> str:
     """The installed FURY's version, read from its metadata without importing it."""
     try:
@@ -95,8 +97,6 @@ def __getattr__(name: str):
     # Resolved on first use, so that loading the pytest plugin (and `--help`) never imports a renderer.
     if name == "NAME":
         return _backend_name()
-    if name in ("describe", "renderer_label"):
-        return globals()[name]
     if name in __all__:
         return getattr(_backend(), name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -8,7 +8,7 @@ from pathlib import Path
 from conformance.errors import ConformanceError
 from conformance.files import write_atomically
 
-__all__ = ["emit", "params", "replace_block"]
+__all__ = ["add_backend_run_arguments", "emit", "params", "replace_block"]
 
 
 def params(text: str | None) -> dict:
@@ -22,6 +22,17 @@ def params(text: str | None) -> dict:
     if not isinstance(value, dict):
         raise ConformanceError(f"--params={text!r} is a JSON {type(value).__name__}, but should be an object of scene parameters")
     return {k: tuple(v) if isinstance(v, list) else v for k, v in value.items()}
+
+
+def add_backend_run_arguments(parser) -> None:
+    """``--json`` and ``--beside``, of ``verdicts`` and ``kill-rate``: keep this backend's run, and put
+    another backend's kept run beside it in the README (the two FURYs live in two environments)."""
+    from conformance.validation import argparse_type, existing_file, file_to_write
+
+    parser.add_argument("--json", type=argparse_type(file_to_write, "--json"), default=None,
+                        help="also keep this run's outcomes here, to be put --beside the other backend's")
+    parser.add_argument("--beside", action="append", type=argparse_type(existing_file, "--beside"), default=[],
+                        help="a run another backend kept with --json: the README table shows both, side by side")
 
 
 def emit(text: str, out: str | None) -> None:

@@ -6,7 +6,7 @@ of failure it finds with its worst figure, so a table cell is everything a sync 
 
 from __future__ import annotations
 
-from conformance.commands.common import emit, replace_block
+from conformance.commands.common import add_backend_run_arguments, emit, replace_block
 from conformance.validation import MAX_JOBS, argparse_type, existing_file, file_to_write, positive_int
 
 NAME = "verdicts"
@@ -22,10 +22,7 @@ def add_arguments(parser) -> None:
     parser.add_argument("--out", type=argparse_type(file_to_write, "--out"), default=None,
                         help="also write the markdown here")
     parser.add_argument("--jobs", type=jobs, default=None, help="pytest processes at a time (default 1)")
-    parser.add_argument("--json", type=argparse_type(file_to_write, "--json"), default=None,
-                        help="also keep this run's outcomes here, to be put --beside the other backend's")
-    parser.add_argument("--beside", action="append", type=argparse_type(existing_file, "--beside"), default=[],
-                        help="a run another backend kept with --json: the README table shows both, side by side")
+    add_backend_run_arguments(parser)
     parser.add_argument("--readme", type=argparse_type(existing_file, "--readme"), default=None, help="also put the scene table in this markdown file, between "
                         "'<!-- conformance:verdicts -->' and '<!-- /conformance:verdicts -->'")
 
