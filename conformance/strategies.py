@@ -15,6 +15,7 @@ from conformance.events import JointReset, Kick, Teleport
 
 __all__ = [
     "HARD_ORIENTATIONS",
+    "app_events",
     "events",
     "frame_counts",
     "hard_orientations",
@@ -106,6 +107,14 @@ def _events_at(frames: int):
     kicks = st.builds(Kick, frame=frame, which=which, velocity=offsets(3.0), offset=offsets(0.05),
                       spin=offsets(20.0))
     return st.one_of(teleports, joint_resets, kicks)
+
+
+def app_events(ticks: int, most: int = 4) -> st.SearchStrategy[list]:
+    """Events for an app (:mod:`conformance.apps.perturb`): as :func:`events`, at ticks 1..``ticks``-1, so
+    that each is applied before one of the app's callbacks and the last tick shows its effect."""
+    import dataclasses
+
+    return events(max(ticks - 1, 1), most).map(lambda es: [dataclasses.replace(e, frame=max(e.frame, 1)) for e in es])
 
 
 def events(frames: int, most: int = 4) -> st.SearchStrategy[list]:

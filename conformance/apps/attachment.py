@@ -1,0 +1,179 @@
+"""Rigid attachment: which frame holds each drawn vertex, and from which tick it stops holding it.
+
+A vertex drawn right is fixed in the link frame of one body or link (or in the world): its coordinates
+in that frame are the same at every tick. So, with no mapping from the user, the kit finds for each
+vertex the frame in which its coordinates vary least, and holds them to the kit's vertex tolerance
+there (:mod:`conformance.tolerances`: the same float32 and pybullet-helper budget as for a scene, per
+frame and actor). Because the reference coordinates are themselves read from the drawing (their
+median over the ticks), a vertex may be off by the tolerance at a tick and by the tolerance in the
+reference: the allowance is twice the tolerance.
+
+What this cannot decide, and what decides it: two frames that never move relative to each other
+(a body at rest on a static one, a static body and the world) hold the same vertices equally; the
+kit then names the first and says so, and its own events (:mod:`conformance.apps.perturb`) move
+dynamic bodies apart. What it cannot see: a drawing held rigidly by the *right* frame at the wrong
+place in it (drawn at the centre of mass, a vertex range following another body):
+:mod:`conformance.apps.placement` judges where in its frame a drawing sits.
+
+Variants of a frame (:data:`VARIANTS`) are the poses of the usual mistakes; a vertex that no frame
+holds but a variant does is diagnosed by it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import cKDTree
+from scipy.spatial.transform import Rotation
+
+from conformance.tolerances import DEFAULT, Tolerance
+
+__all__ = ["Attachment", "VARIANTS", "attach", "local_coordinates", "variant_fit"]
+
+#: nearest frames (by origin, at the first judged tick) tried for each vertex before all of them
+NEAREST = 32
+#: ticks compared when choosing a vertex's frame (all ticks are compared once it is chosen)
+PROBES = 8
+
+
+@dataclass
+class Attachment:
+    """For each vertex of one actor: ``frame`` (index into the recording's frames, ``-1`` the world),
+    ``error`` ``(T,)`` per judged tick (metres from where that frame carries it), ``allowance`` (twice
+    the tolerance), ``reference`` (its coordinates in that frame), and ``tied`` (another frame holds it
+    as well: undecidable from this run)."""
+
+    frame: np.ndarray      # (n,) int
+    error: np.ndarray      # (n, T) float
+    allowance: np.ndarray  # (n,) float
+    reference: np.ndarray  # (n, 3)
+    tied: np.ndarray       # (n,) bool
+
+    @property
+    def held(self) -> np.ndarray:
+        return np.all(self.error <= self.allowance[:, None], axis=1)
+
+
+def _world(positions: np.ndarray, rotations: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Frame poses with the world appended as the last frame."""
+    t = positions.shape[0]
+    pos = np.concatenate([positions, np.zeros((t, 1, 3))], axis=1)
+    rot = np.concatenate([rotations, np.broadcast_to(np.eye(3), (t, 1, 3, 3))], axis=1)
+    return pos, rot
+
+
+def local_coordinates(vertices: np.ndarray, positions: np.ndarray, rotations: np.ndarray) -> np.ndarray:
+    """``vertices`` ``(T, n, 3)`` in the frames ``(T, n, 3)`` / ``(T, n, 3, 3)`` (one frame per vertex): ``Rᵀ (v - p)``."""
+    return np.einsum("tnji,tnj->tni", rotations, vertices - positions)
+
+
+def _spreads(vertices, positions, rotations, candidates, probes):
+    """Largest change of each vertex's coordinates over the ``probes`` ticks, in each candidate frame:
+    ``(n, k)`` for ``candidates`` ``(n, k)`` frame indices."""
+    v = vertices[probes][:, :, None, :]                        # (P, n, 1, 3)
+    p = positions[probes][:, candidates]                       # (P, n, k, 3)
+    r = rotations[probes][:, candidates]                       # (P, n, k, 3, 3)
+    local = np.einsum("pnkji,pnkj->pnki", r, v - p)
+    return np.max(np.linalg.norm(local - local[:1], axis=-1), axis=0)
+
+
+def _probes(ticks: int, extra=()) -> np.ndarray:
+    chosen = set(np.linspace(0, ticks - 1, min(PROBES, ticks)).round().astype(int).tolist())
+    chosen.update(t for t in extra if 0 <= t < ticks)
+    return np.array(sorted(chosen))
+
+
+def attach(vertices: np.ndarray, positions: np.ndarray, rotations: np.ndarray, *, tolerance: Tolerance = DEFAULT,
+           event_ticks=()) -> Attachment:
+    """Find the frame holding each vertex and its error at every tick.
+
+    ``vertices`` ``(T, n, 3)`` are one actor's drawn vertices at the judged ticks; ``positions``
+    ``(T, F, 3)`` and ``rotations`` ``(T, F, 3, 3)`` the link frames at the same ticks. Every vertex is
+    tried in its :data:`NEAREST` nearest frames and the world; one that none of them holds is tried in
+    every frame (so a range following a far-away body is still found)."""
+    ticks, n, _ = vertices.shape
+    frames = positions.shape[1]
+    pos, rot = _world(positions, rotations)
+    probes = _probes(ticks, [t - 1 for t in event_ticks] + list(event_ticks))
+    k = min(frames, NEAREST)
+    if k:
+        _, nearest = cKDTree(positions[0]).query(vertices[0], k=k)
+        nearest = np.asarray(nearest).reshape(n, k)
+        candidates = np.concatenate([nearest, np.full((n, 1), frames)], axis=1)
+    else:
+        candidates = np.full((n, 1), frames)
+    spreads = np.concatenate([_spreads(vertices[:, i:i + 4096], pos, rot, candidates[i:i + 4096], probes)
+                              for i in range(0, n, 4096)]) if n else np.zeros((0, candidates.shape[1]))
+    best = candidates[np.arange(n), np.argmin(spreads, axis=1)] if n else np.zeros(0, dtype=int)
+    best_spread = spreads.min(axis=1) if n else np.zeros(0)
+    allowance = _allowance(vertices, pos, rot, best, tolerance)
+    loose = np.flatnonzero(best_spread > allowance)
+    if len(loose) and frames > k:
+        everything = np.broadcast_to(np.arange(frames + 1), (len(loose), frames + 1))
+        full = np.concatenate([_spreads(vertices[:, loose[i:i + 256]], pos, rot, everything[i:i + 256], probes)
+                               for i in range(0, len(loose), 256)])
+        better = full.min(axis=1) < best_spread[loose]
+        best[loose[better]] = np.argmin(full[better], axis=1)
+        allowance = _allowance(vertices, pos, rot, best, tolerance)
+    tied = np.sum(spreads <= np.maximum(allowance, 1e-12)[:, None], axis=1) > 1 if n else np.zeros(0, dtype=bool)
+    local = local_coordinates(vertices, pos[:, best], rot[:, best])
+    reference = np.median(local, axis=0)
+    error = np.linalg.norm(local - reference, axis=-1).T
+    frame = np.where(best == frames, -1, best)
+    return Attachment(frame=frame, error=error, allowance=allowance, reference=reference, tied=tied)
+
+
+def _allowance(vertices, pos, rot, best, tolerance: Tolerance) -> np.ndarray:
+    """Twice the kit's tolerance for each vertex, from the extent of the vertices its frame holds in
+    this actor and the frame's largest distance from the origin."""
+    local0 = np.einsum("nji,nj->ni", rot[0, best], vertices[0] - pos[0, best])
+    radius = np.linalg.norm(local0, axis=1)
+    extent = np.zeros(pos.shape[1])
+    np.maximum.at(extent, best, radius)
+    distance = np.max(np.linalg.norm(pos[:, best], axis=-1), axis=0)
+    e = extent[best]
+    return 2 * (tolerance.size_rtol * e + tolerance.position_rtol * (distance + e) + tolerance.atol)
+
+
+# -- the usual mistakes, as frames ----------------------------------------------------------------
+
+def _vtk_euler(quaternions: np.ndarray) -> np.ndarray:
+    """What ``SetOrientation(*degrees(getEulerFromQuaternion(q)))`` draws: pyBullet's roll, pitch, yaw
+    (about fixed x, y, z) used by VTK as the angles of ``Rz·Rx·Ry`` (measured: intrinsic z, x, y)."""
+    roll, pitch, yaw = Rotation.from_quat(quaternions.reshape(-1, 4)).as_euler("xyz").T
+    return Rotation.from_euler("ZXY", np.stack([yaw, roll, pitch], axis=1)).as_matrix().reshape(quaternions.shape[:-1] + (3, 3))
+
+
+def _rotations(quaternions: np.ndarray) -> np.ndarray:
+    return Rotation.from_quat(quaternions.reshape(-1, 4)).as_matrix().reshape(quaternions.shape[:-1] + (3, 3))
+
+
+#: name → (what it means, function of (positions, quaternions, before_positions, before_quaternions)
+#: giving the frame positions and rotation matrices that mistake draws with)
+VARIANTS = {
+    "previous-step": ("drawn exactly at pyBullet's pose of the previous step: sync after p.stepSimulation(), and "
+                      "read links with getLinkState(..., computeForwardKinematics=1)",
+                      lambda p, q, bp, bq: (bp, _rotations(bq))),
+    "conjugate": ("drawn with the inverse (conjugate, or transposed-matrix) rotation: a row-vector `v @ R` where "
+                  "`R @ v` was meant, or a matrix written transposed",
+                  lambda p, q, bp, bq: (p, np.swapaxes(_rotations(q), -1, -2))),
+    "wxyz": ("drawn with the quaternion's components in (w, x, y, z) order read as pyBullet's (x, y, z, w)",
+             lambda p, q, bp, bq: (p, _rotations(np.roll(q, 1, axis=-1)))),
+    "euler-order": ("drawn with pyBullet's Euler angles applied in VTK's order (SetOrientation turns about z, then x, "
+                    "then y; getEulerFromQuaternion's angles are about fixed x, y, z): set a matrix from the quaternion",
+                    lambda p, q, bp, bq: (p, _vtk_euler(q))),
+    "translation-only": ("moved but never turned: the position is pyBullet's, the rotation the one it was built with",
+                         lambda p, q, bp, bq: (p, np.broadcast_to(np.eye(3), p.shape[:-1] + (3, 3)))),
+}
+
+
+def variant_fit(vertices: np.ndarray, positions: np.ndarray, rotations: np.ndarray, reference: np.ndarray,
+                allowance: np.ndarray, ticks: np.ndarray) -> bool:
+    """Whether the vertices ``(T, m, 3)`` sit at ``reference`` (or at one fixed place of their own) in the
+    frames ``(T, m, 3)``/``(T, m, 3, 3)`` at every tick of ``ticks`` (indices), within ``allowance``."""
+    local = local_coordinates(vertices[ticks], positions[ticks], rotations[ticks])
+    for ref in (reference, np.median(local_coordinates(vertices, positions, rotations), axis=0)):
+        if np.all(np.linalg.norm(local - ref, axis=-1) <= allowance):
+            return True
+    return False

@@ -1,0 +1,98 @@
+"""Every frame pyBullet simulates on an app's clients: what exists, what it is called, and where it is.
+
+An app is judged against *all* of its bodies, not a list it hands the kit: each base and each link of
+each body on each client the app connected is a frame that drawn vertices may follow. A frame's pose
+is its link frame (pybullet-facts.md, "Frames"): for a base, ``getBasePositionAndOrientation`` with the
+inertial offset of ``getDynamicsInfo(body, -1)[3:5]`` undone; for a link,
+``getLinkState(..., computeForwardKinematics=1)[4:6]`` (:func:`conformance.truth.link_frames`).
+
+A frame's collision shape is described in its link frame (``getCollisionShapeData`` gives it in the
+centre-of-mass frame, which is the link frame moved by the local inertial frame), so the kit can tell
+where the app should have drawn it (:mod:`conformance.apps.placement`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+import pybullet
+
+from conformance import poses, truth
+from conformance.client import BoundClient
+
+__all__ = ["Frame", "frames_of", "read_poses"]
+
+#: pybullet's shape type codes, by name, for the records
+SHAPE_KINDS = {pybullet.GEOM_BOX: "box", pybullet.GEOM_SPHERE: "sphere", pybullet.GEOM_CYLINDER: "cylinder",
+               pybullet.GEOM_CAPSULE: "capsule", pybullet.GEOM_MESH: "mesh", pybullet.GEOM_PLANE: "plane"}
+
+
+@dataclass(frozen=True)
+class Frame:
+    """One base (``link == -1``) or link of one body on one client.
+
+    ``shapes`` are its collision shapes as ``(kind, dims, position, orientation)`` in its link frame
+    (``dims`` as ``getCollisionShapeData`` gives them: box full extents, sphere ``(r, ...)``, cylinder and
+    capsule ``(height, radius, ...)``); ``mass`` 0 is a static base (or a fixed link)."""
+
+    client: int
+    body: int
+    link: int
+    name: str
+    mass: float
+    shapes: tuple
+    inertial: tuple = (0.0, 0.0, 0.0)  # the centre of mass in the link frame (getDynamicsInfo()[3])
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+    @property
+    def label(self) -> str:
+        where = "base" if self.link == -1 else f"link {self.link}"
+        return f"body {self.body} {where}" + (f" ({self.name})" if self.name else "")
+
+
+def _text(value) -> str:
+    return value.decode("utf-8", "replace") if isinstance(value, bytes) else str(value)
+
+
+def _shapes(p: BoundClient, body: int, link: int) -> tuple:
+    inertial_pos, inertial_orn = p.getDynamicsInfo(body, link)[3:5]
+    found = []
+    for data in p.getCollisionShapeData(body, link):
+        kind = SHAPE_KINDS.get(data[2], f"type {data[2]}")
+        pos, orn = poses.compose(inertial_pos, inertial_orn, data[5], data[6])
+        found.append((kind, tuple(float(v) for v in data[3]), tuple(float(v) for v in pos), tuple(float(v) for v in orn)))
+    return tuple(found)
+
+
+def frames_of(clients) -> list[Frame]:
+    """Every base and link of every body on ``clients`` (ids), in client, body and link order."""
+    frames = []
+    for client in clients:
+        p = BoundClient(client)
+        for index in range(p.getNumBodies()):
+            body = p.getBodyUniqueId(index)
+            base_name, body_name = (_text(v) for v in p.getBodyInfo(body))
+            name = body_name if body_name and body_name != base_name else base_name
+            info = p.getDynamicsInfo(body, -1)
+            frames.append(Frame(client, body, -1, name, float(info[0]), _shapes(p, body, -1), tuple(info[3])))
+            for link in range(p.getNumJoints(body)):
+                link_name = _text(p.getJointInfo(body, link)[12])
+                info = p.getDynamicsInfo(body, link)
+                frames.append(Frame(client, body, link, link_name, float(info[0]), _shapes(p, body, link), tuple(info[3])))
+    return frames
+
+
+def read_poses(frames: list[Frame]) -> tuple[np.ndarray, np.ndarray]:
+    """Link-frame positions ``(F, 3)`` and quaternions ``(F, 4)`` of ``frames``, now."""
+    positions = np.empty((len(frames), 3))
+    orientations = np.empty((len(frames), 4))
+    by_client: dict[int, list[int]] = {}
+    for i, frame in enumerate(frames):
+        by_client.setdefault(frame.client, []).append(i)
+    for client, rows in by_client.items():
+        pos, orn = truth.link_frames(BoundClient(client), [(frames[i].body, frames[i].link) for i in rows])
+        positions[rows], orientations[rows] = pos, orn
+    return positions, orientations

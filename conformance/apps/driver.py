@@ -1,0 +1,262 @@
+"""Running an app's own loop under the kit, in the app's process (:mod:`conformance.apps.child`).
+
+The kit patches three things before the app's script runs, and nothing in the script:
+
+* ``pybullet.connect``/``disconnect`` to learn the app's clients (and to run the loop before an app
+  that ends with ``p.disconnect()`` takes its bodies away);
+* ``pybullet.stepSimulation`` to count the steps of each tick and to read every frame just before
+  each step (so that a drawing one step behind is recognised as such);
+* FURY's window loop (:mod:`conformance.apps.takeover_vtk`, :mod:`conformance.apps.takeover_pygfx`):
+  the call that would wait for a person (``showm.start()``, ``window.show``, ``window.record``…)
+  drives the app's own per-frame callbacks ``ticks`` times instead, recording after each tick.
+
+Between ticks the kit may apply its own events (teleports, kicks, joint resets) to the app's bodies,
+as it does to its scenes: that is what makes the judgement property-based on an app too.
+"""
+
+from __future__ import annotations
+
+import sys
+import traceback
+from types import SimpleNamespace
+
+import numpy as np
+import pybullet
+
+from conformance.apps import bodies
+from conformance.apps.recording import ActorTrack, Recording
+from conformance.errors import ConformanceError
+
+__all__ = ["AppLoopNotFound", "Driver"]
+
+
+class AppLoopNotFound(ConformanceError):
+    """The app never handed the kit a per-frame function it could drive."""
+
+
+HOW_TO_EXPOSE = (
+    "The kit drives an app through FURY's own loop: on FURY 0.12 a function registered with "
+    "`showm.add_timer_callback(True, ms, callback)` (or a TimerEvent observer on `showm.iren`), on FURY 2 one "
+    "registered with `showm.register_callback(callback, seconds, True, name)`, run once a tick when the app calls "
+    "`showm.start()`, `window.show(...)` or `window.record(...)`/`window.snapshot(...)`, or when it disconnects "
+    "pyBullet. If your program steps and syncs in a loop of its own, put one frame of it (step, then sync) in a "
+    "module-level function and name it with `--tick NAME` (pytest: `conformance_app_tick = NAME`)."
+)
+
+
+class _TickFunction:
+    """A module-level function of the app, named with ``--tick``, as the loop."""
+
+    def __init__(self, name: str):
+        self.name = name
+
+    def _function(self):
+        main = sys.modules.get("__main__")
+        function = getattr(main, self.name, None)
+        return function if callable(function) else None
+
+    def ready(self) -> bool:
+        return self._function() is not None
+
+    def tick(self) -> None:
+        self._function()()
+
+    def done(self) -> bool:
+        return False
+
+    def actors(self):
+        return []
+
+    def describe(self) -> str:
+        return f"the app's function {self.name}(), once a tick"
+
+    def ended(self) -> str:
+        return ""
+
+
+def _labels(actors) -> dict[int, str]:
+    """Names the app's own module gives its actors (``rope_actor``, ``brick_actors[3]``), by ``id``."""
+    main = sys.modules.get("__main__")
+    names: dict[int, str] = {}
+    wanted = {id(a) for a in actors}
+    for name, value in list(vars(main).items()) if main is not None else []:
+        if name.startswith("__"):
+            continue
+        if id(value) in wanted:
+            names.setdefault(id(value), name)
+        elif isinstance(value, (list, tuple)):
+            for i, item in enumerate(value[:100000]):
+                if id(item) in wanted:
+                    names.setdefault(id(item), f"{name}[{i}]")
+        elif isinstance(value, dict):
+            for key, item in list(value.items())[:100000]:
+                if id(item) in wanted:
+                    names.setdefault(id(item), f"{name}[{key!r}]")
+    return names
+
+
+class Driver:
+    """The kit's side of an app's process: its clients, its loop, and what is recorded of it."""
+
+    def __init__(self, backend: str, script: str, ticks: int, events=(), tick_function: str | None = None,
+                 backend_module=None, scene_actors=None):
+        self.backend, self.script, self.ticks = backend, script, ticks
+        self.events = list(events)
+        self.tick_function = _TickFunction(tick_function) if tick_function else None
+        self.sources: list = []
+        self.clients: list[int] = []
+        self.finished = False
+        self.recording: Recording | None = None
+        self.error: str | None = None
+        self.entry = ""
+        self._backend = backend_module
+        self._frames: list[bodies.Frame] = []
+        self._before = None
+        self._steps = 0
+
+    # -- what the patches call ------------------------------------------------------------------
+    def offer(self, source) -> None:
+        self.sources.append(source)
+
+    def reached(self, entry: str) -> None:
+        """The app called something that would hand its loop to a window: drive it now (once)."""
+        if not self.finished:
+            self.entry = entry
+            self.run()
+
+    def connected(self, client: int) -> None:
+        if client >= 0:
+            self.clients.append(client)
+
+    def before_disconnect(self, client) -> None:
+        if not self.finished and self._source() is not None:
+            self.entry = "p.disconnect()"
+            self.run()
+
+    def before_step(self) -> None:
+        if self._frames:
+            self._before = bodies.read_poses(self._frames)
+            self._steps += 1
+
+    # -- the loop --------------------------------------------------------------------------------
+    def _source(self):
+        if self.tick_function is not None and self.tick_function.ready():
+            return self.tick_function
+        for source in self.sources:
+            if source.ready():
+                return source
+        return None
+
+    def run(self) -> None:
+        """Drive the app's loop for up to ``ticks`` ticks, recording after each; keeps what it saw even
+        when the app raises (``self.error``)."""
+        self.finished = True
+        source = self._source()
+        if source is None:
+            raise AppLoopNotFound(
+                f"{self.script}: the app reached {self.entry or 'its end'} without registering a per-frame function "
+                f"the kit could drive ({len(self.sources)} ShowManager(s) made, none with a callback). " + HOW_TO_EXPOSE)
+        clients = [c for c in dict.fromkeys(self.clients) if pybullet.isConnected(physicsClientId=c)]
+        if not clients:
+            raise AppLoopNotFound(f"{self.script}: the app has no pyBullet client connected when its loop starts "
+                                  "(it connected none, or disconnected before handing over its loop), so there is "
+                                  "nothing to judge its drawing against. " + HOW_TO_EXPOSE)
+        actors = source.actors() or [a for s in self.sources for a in s.actors()]
+        if not actors:
+            raise AppLoopNotFound(f"{self.script}: the app's scene has no actor drawing polygons, so there is nothing "
+                                  "to check; add the actors to the scene the ShowManager shows.")
+        self._frames = bodies.frames_of(clients)
+        names = _labels(actors)
+        tracks = [_Track(a, names.get(id(a)) or f"actor #{i}", self._backend) for i, a in enumerate(actors)]
+        end_pos, end_orn, before_pos, before_orn, steps = [], [], [], [], []
+
+        def snapshot():
+            pos, orn = bodies.read_poses(self._frames)
+            end_pos.append(pos), end_orn.append(orn)
+            before = self._before if self._before is not None else (pos, orn)
+            before_pos.append(before[0]), before_orn.append(before[1])
+            for track in tracks:
+                track.snapshot()
+
+        snapshot()
+        steps.append(0)
+        ended = f"the kit's tick limit ({self.ticks})"
+        from conformance.apps import perturb
+
+        try:
+            for tick in range(1, self.ticks + 1):
+                perturb.apply(self.events, tick, clients[0], self._frames)
+                self._steps = 0
+                self._before = None
+                source.tick()
+                snapshot()
+                steps.append(self._steps)
+                if source.done():
+                    ended = f"{source.ended()} after tick {tick}"
+                    break
+        except Exception as exc:  # the app's own code raised inside its callback: that is a verdict
+            self.error = (f"the app raised at tick {len(steps)}: {type(exc).__name__}: {exc}\n"
+                          + "".join(traceback.format_exception(exc)[-6:]))
+            ended = f"the app raised at tick {len(steps)}"
+        notes = []
+        if source.actors() and len(source.actors()) != len(actors):
+            notes.append(f"the scene had {len(actors)} actors when the loop started and {len(source.actors())} at its end; "
+                         "actors added later are not judged")
+        self.recording = Recording(
+            script=self.script, backend=self.backend, actors=[t.result(len(end_pos)) for t in tracks],
+            frames=self._frames, positions=np.array(end_pos), orientations=np.array(end_orn),
+            before_positions=np.array(before_pos), before_orientations=np.array(before_orn),
+            steps=np.array(steps, dtype=np.int64), loop=f"{source.describe()} (handed over at {self.entry or 'the end of the script'})",
+            ended=ended, events=[perturb.as_dict(e) for e in self.events], notes=notes)
+
+
+class _Track:
+    """What is recorded of one actor, tick by tick."""
+
+    def __init__(self, actor, label: str, backend):
+        self.actor, self.label, self.backend = actor, label, backend
+        self.vertices: list[np.ndarray] = []
+        self.normals: list[np.ndarray] = []
+        self.changed: list[bool] = []
+        self.announced: list[bool] = []
+        self._state = None
+
+    def snapshot(self) -> None:
+        self.vertices.append(np.array(self.backend.world_vertices(self.actor), dtype=np.float64))
+        normals = self.backend.world_normals(self.actor)
+        if normals is not None:
+            self.normals.append(np.array(normals, dtype=np.float64))
+        state = self.backend.content_state(self.actor)
+        if self._state is None:
+            self.changed.append(False)
+            self.announced.append(False)
+        else:
+            self.changed.append(state[1] != self._state[1])
+            self.announced.append(state[0] != self._state[0])
+        self._state = state
+
+    def result(self, ticks: int) -> ActorTrack:
+        kind = type(self.actor).__name__
+        normals = np.array(self.normals) if len(self.normals) == ticks else None
+        return ActorTrack(self.label, kind, np.array(self.vertices), normals,
+                          np.array(self.changed), np.array(self.announced))
+
+
+def install_pybullet(driver: Driver) -> None:
+    """Wrap ``pybullet.connect``, ``disconnect`` and ``stepSimulation`` for ``driver`` (in the app's process)."""
+    connect, disconnect, step = pybullet.connect, pybullet.disconnect, pybullet.stepSimulation
+
+    def connect_(*args, **kwargs):
+        client = connect(*args, **kwargs)
+        driver.connected(client)
+        return client
+
+    def disconnect_(*args, **kwargs):
+        driver.before_disconnect(kwargs.get("physicsClientId", args[0] if args else 0))
+        return disconnect(*args, **kwargs)
+
+    def step_(*args, **kwargs):
+        driver.before_step()
+        return step(*args, **kwargs)
+
+    pybullet.connect, pybullet.disconnect, pybullet.stepSimulation = connect_, disconnect_, step_

@@ -1,0 +1,52 @@
+"""The kit's own events on an app: teleports, kicks and joint resets between ticks.
+
+An app's bodies move only as its story goes: a wall that tips about one axis never shows that Euler
+angles applied in the wrong order turn a body about the wrong axes. Because the kit drives the app's
+loop, it can do to the app what it does to its scenes (:mod:`conformance.events`): before the app's
+callback of tick ``k``, turn a body to a hard orientation, kick it, or reset a joint, so that the app's
+sync has to draw poses its story never produces. Events name bodies by position in the list of the
+app's *dynamic* bodies (``which`` modulo its length; static bodies are left where the app put them,
+so an app may draw them as part of the world) and joints by position in the list of movable joints,
+and are drawn by Hypothesis (:func:`conformance.strategies.app_events`), so a failure is reproducible from its JSON.
+"""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+from conformance import events as scene_events
+from conformance.apps.bodies import Frame
+
+__all__ = ["apply", "as_dict", "from_dicts"]
+
+
+def _scene(client: int, frames: list[Frame], dynamic: bool):
+    from conformance.client import BoundClient
+
+    p = BoundClient(client)
+    wanted = sorted({f.body for f in frames if f.client == client and f.link == -1 and (f.mass > 0 or not dynamic)})
+    dt = p.getPhysicsEngineParameters()["fixedTimeStep"]
+    return SimpleNamespace(p=p, bindings=[SimpleNamespace(body=b) for b in wanted], dt=dt)
+
+
+def apply(events, tick: int, client: int, frames: list[Frame]) -> None:
+    """Apply the events of ``tick`` to the app's first client (before the app's callback of that tick)."""
+    due = [e for e in events if e.frame == tick]
+    if not due:
+        return
+    for event in due:
+        scene = _scene(client, frames, dynamic=not isinstance(event, scene_events.JointReset))
+        if scene.bindings:
+            event.apply(scene)
+
+
+def as_dict(event) -> dict:
+    import json
+
+    return json.loads(scene_events.dumps([event]))[0]
+
+
+def from_dicts(items) -> list:
+    import json
+
+    return scene_events.loads(json.dumps(list(items)))

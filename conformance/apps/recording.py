@@ -1,0 +1,104 @@
+"""What the kit saw of an app, tick by tick: the one thing the app's process hands back to the kit.
+
+Index 0 of every per-tick array is the moment the kit took over the app's loop (the app built its
+bodies and actors; no callback has run yet); index ``k`` is the end of the app's ``k``-th tick, which
+is what its window draws next. A recording is plain numpy and JSON, so the judgement
+(:mod:`conformance.apps.judge`) needs neither FURY nor pybullet and is tested on recordings made by hand.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from conformance.apps.bodies import Frame
+from conformance.files import write_atomically
+
+__all__ = ["ActorTrack", "Recording", "load", "save"]
+
+
+@dataclass
+class ActorTrack:
+    """One drawn actor: world vertices ``(T+1, n, 3)`` as the renderer draws them (through the actor's
+    full matrix), its stored normals as lit ``(T+1, n, 3)`` or None, and per tick whether its vertex
+    data changed and whether the change was announced to the renderer (VTK ``Modified()``, pygfx
+    ``update_range``/``update_full``)."""
+
+    label: str
+    kind: str
+    vertices: np.ndarray
+    normals: np.ndarray | None
+    changed: np.ndarray
+    announced: np.ndarray
+
+
+@dataclass
+class Recording:
+    """An app's run under the kit: its actors, its frames (every base and link on its clients) with
+    their link-frame poses after each tick and just before each tick's last ``stepSimulation``, the
+    steps per tick, and how the loop was taken over."""
+
+    script: str
+    backend: str
+    actors: list[ActorTrack]
+    frames: list[Frame]
+    positions: np.ndarray       # (T+1, F, 3) link frames at the end of each tick
+    orientations: np.ndarray    # (T+1, F, 4)
+    before_positions: np.ndarray     # (T+1, F, 3) link frames just before the tick's last step
+    before_orientations: np.ndarray
+    steps: np.ndarray           # (T+1,) stepSimulation calls in each tick (index 0: 0)
+    loop: str = ""              # how the kit drove the app, in words
+    ended: str = ""             # why the loop ended
+    events: list = field(default_factory=list)
+    notes: list = field(default_factory=list)
+    error: str = ""             # the app raised inside its loop: what and where
+
+    @property
+    def ticks(self) -> int:
+        return len(self.steps) - 1
+
+
+def save(recording: Recording, path) -> None:
+    """Write ``recording`` to ``path`` (an ``.npz``), whole or not at all."""
+    arrays = {"positions": recording.positions, "orientations": recording.orientations,
+              "before_positions": recording.before_positions, "before_orientations": recording.before_orientations,
+              "steps": recording.steps}
+    actors = []
+    for i, track in enumerate(recording.actors):
+        arrays[f"a{i}_vertices"] = track.vertices
+        arrays[f"a{i}_changed"] = track.changed
+        arrays[f"a{i}_announced"] = track.announced
+        if track.normals is not None:
+            arrays[f"a{i}_normals"] = track.normals
+        actors.append({"label": track.label, "kind": track.kind, "normals": track.normals is not None})
+    meta = {"script": recording.script, "backend": recording.backend, "actors": actors,
+            "frames": [f.as_dict() for f in recording.frames], "loop": recording.loop, "ended": recording.ended,
+            "events": recording.events, "notes": recording.notes,
+            "error": recording.error}
+    arrays["meta"] = np.frombuffer(json.dumps(meta).encode("utf-8"), dtype=np.uint8)
+    buffer = io.BytesIO()
+    np.savez(buffer, **arrays)
+    write_atomically(Path(path), buffer.getvalue())
+
+
+def _frame(d: dict) -> Frame:
+    shapes = tuple((s[0], tuple(s[1]), tuple(s[2]), tuple(s[3])) for s in d["shapes"])
+    return Frame(d["client"], d["body"], d["link"], d["name"], d["mass"], shapes, tuple(d.get("inertial", (0.0, 0.0, 0.0))))
+
+
+def load(path) -> Recording:
+    with np.load(path) as data:
+        meta = json.loads(bytes(data["meta"]).decode("utf-8"))
+        actors = []
+        for i, a in enumerate(meta["actors"]):
+            actors.append(ActorTrack(a["label"], a["kind"], data[f"a{i}_vertices"],
+                                     data[f"a{i}_normals"] if a["normals"] else None,
+                                     data[f"a{i}_changed"], data[f"a{i}_announced"]))
+        return Recording(meta["script"], meta["backend"], actors, [_frame(f) for f in meta["frames"]],
+                         data["positions"], data["orientations"], data["before_positions"],
+                         data["before_orientations"], data["steps"], meta["loop"], meta["ended"],
+                         meta["events"], meta["notes"], meta.get("error", ""))

@@ -1,0 +1,84 @@
+"""Taking over FURY 0.12's window loop (VTK).
+
+A FURY 0.12 app registers its per-frame function with ``ShowManager.add_timer_callback`` (or straight
+on the interactor, ``showm.iren.AddObserver("TimerEvent", f)``) and hands control to
+``showm.start()``, ``window.show`` or, when not interactive, ``window.record``. The kit leaves
+``add_timer_callback``, ``render`` and ``exit`` as FURY wrote them (the window is off-screen, on the
+kit's X display) and replaces only the calls that would wait for a person: ``start``, ``show`` and
+``record`` drive the loop instead. One tick is one ``TimerEvent`` invoked on the interactor, which is
+what VTK does when a timer fires: every ``TimerEvent`` observer runs once, with ``(iren, "TimerEvent")``.
+The loop ends after the kit's tick count or when the app calls ``showm.exit()`` (VTK's ``GetDone()``).
+"""
+
+from __future__ import annotations
+
+__all__ = ["install", "scene_actors"]
+
+KIND = "FURY 0.12 ShowManager"
+
+
+class _Source:
+    """One ShowManager as a loop the kit drives."""
+
+    def __init__(self, showm):
+        self.showm = showm
+
+    def ready(self) -> bool:
+        iren = getattr(self.showm, "iren", None)
+        return iren is not None and bool(iren.HasObserver("TimerEvent"))
+
+    def tick(self) -> None:
+        self.showm.iren.InvokeEvent("TimerEvent")
+
+    def done(self) -> bool:
+        return bool(self.showm.iren.GetDone())
+
+    def actors(self):
+        return scene_actors(self.showm.scene)
+
+    def describe(self) -> str:
+        return "FURY 0.12 ShowManager: its TimerEvent observers (add_timer_callback), once a tick"
+
+    def ended(self) -> str:
+        return "the app called showm.exit()"
+
+
+def scene_actors(scene) -> list:
+    """The scene's 3D actors that draw polygon data (2D text and UI actors are not bodies)."""
+    found = []
+    collection = scene.GetActors()
+    collection.InitTraversal()
+    for _ in range(collection.GetNumberOfItems()):
+        actor = collection.GetNextActor()
+        mapper = actor.GetMapper()
+        data = mapper.GetInput() if mapper is not None else None
+        if data is not None and hasattr(data, "GetPoints") and data.GetPoints() is not None and data.GetNumberOfPoints():
+            found.append(actor)
+    return found
+
+
+def install(driver) -> None:
+    """Patch FURY 0.12's window module so that the app's loop runs under ``driver``."""
+    from fury import window
+
+    original_init = window.ShowManager.__init__
+
+    def __init__(self, *args, **kwargs):
+        original_init(self, *args, **kwargs)
+        self.window.SetOffScreenRendering(1)  # drawn on the kit's display, never mapped
+        driver.offer(_Source(self))
+
+    def start(self, *args, **kwargs):
+        driver.reached("showm.start()")
+
+    def show(*args, **kwargs):
+        driver.reached("window.show()")
+
+    def record(*args, **kwargs):
+        driver.reached("window.record()")  # the app's picture file is not written
+
+    window.ShowManager.__init__ = __init__
+    window.ShowManager.start = start
+    window.show = show
+    window.record = record
+

@@ -1,0 +1,76 @@
+"""``app PATH.py [PATH.py …] [--ticks N] [--perturbed K] [--events JSON] [--tick NAME]``: check your own
+program, unmodified: the kit runs it headless, drives its own per-frame callback, and judges what its
+actors draw against every body pyBullet simulates (no mapping needed; see conformance.apps)."""
+
+from __future__ import annotations
+
+import json
+
+from conformance import validation
+
+NAME = "app"
+HELP = "check an application as it is: its own script, actors and loop"
+
+
+def add_arguments(parser) -> None:
+    parser.add_argument("paths", nargs="+", metavar="PATH.py", help="the app's script(s)")
+    parser.add_argument("--ticks", default=None, metavar="N", help="ticks of the app's own run (default 120; the app "
+                        "may end sooner with showm.exit())")
+    parser.add_argument("--perturbed", default="3", metavar="K", help="runs with the kit's teleports, kicks and joint "
+                        "resets drawn by Hypothesis between ticks (default 3; 0 for none)")
+    parser.add_argument("--events", default=None, help="one run with these events (JSON, from a failure's reproduce line)")
+    parser.add_argument("--tick", default=None, metavar="NAME", help="a module-level function of the app to call once "
+                        "a tick, for an app whose loop is its own")
+    parser.add_argument("--timeout", default="300", metavar="S", help="seconds one run of the app may take (default 300)")
+
+
+def _print_result(result, label: str) -> None:
+    r = result.recording
+    steps = sorted(set(int(s) for s in r.steps[1:])) or [0]
+    print(f"{label}: {r.ticks} ticks ({'/'.join(map(str, steps))} step(s) per tick); {r.ended}")
+    for check, verdict in result.verdicts.items():
+        figure = f"  worst {verdict.worst:.3g} of its allowance" if verdict.worst is not None and verdict.passed else ""
+        print(f"  {'PASS' if verdict.passed else 'FAIL'} {check}{figure}")
+        for line in verdict.lines[:12]:
+            print(f"      {line}")
+        if len(verdict.lines) > 12:
+            print(f"      … {len(verdict.lines) - 12} more lines")
+    if not result.passed:
+        print(f"  reproduce: {result.reproduce()}")
+
+
+def run(args, extra) -> int:
+    from conformance import apps, backends
+    from conformance.apps import perturbed
+
+    ticks = apps.DEFAULT_TICKS if args.ticks is None else validation.whole_number("--ticks", args.ticks, low=1,
+                                                                                  high=validation.MAX_STEPS)
+    runs = validation.whole_number("--perturbed", args.perturbed, low=0, high=1000)
+    timeout = validation.finite_non_negative("--timeout", args.timeout)
+    events = None
+    if args.events is not None:
+        from conformance.apps import perturb
+
+        events = [perturb.as_dict(e) for e in perturb.from_dicts(json.loads(args.events) if args.events.strip() else [])]
+    failed = 0
+    for path in args.paths:
+        print(f"app {path} ({backends.describe()})")
+        try:
+            result = apps.check_app(path, ticks=ticks, events=events or (), tick_function=args.tick, timeout=timeout)
+        except apps.AppFailed as err:
+            print(f"  FAIL runs\n      {err}")
+            failed += 1
+            continue
+        print(f"  loop: {result.recording.loop}")
+        _print_result(result, "own run" if not events else "run with the given events")
+        ok = result.passed
+        if ok and events is None and runs:
+            found = perturbed.search(path, examples=runs, tick_function=args.tick, timeout=timeout)
+            if found is None:
+                print(f"  PASS perturbed: {runs} runs of {apps.PERTURBED_TICKS} ticks with the kit's teleports, kicks and joint resets")
+            else:
+                ok = False
+                _print_result(found, f"perturbed run (events {json.dumps(found.events)}; not shrunk)")
+        failed += not ok
+        print(f"verdict: {'PASS' if ok else 'FAIL'} {path}")
+    return 1 if failed else 0
