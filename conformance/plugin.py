@@ -63,6 +63,13 @@ def pytest_addoption(parser: pytest.Parser) -> None:
                     "failure and every kind that failed with its worst figure (what 'verdicts' uses; default: stop "
                     "at the first failing frame)")
     parser.addini("conformance_survey", "default for --conformance-survey", type="bool", default=False)
+    group.addoption("--conformance-app", dest="conformance_app", action="append", default=None, metavar="PATH",
+                    help="an application script to check as it is (repeatable; replaces the ini conformance_apps)")
+    parser.addini("conformance_apps", "application scripts to check as they are: globs relative to the rootdir, "
+                  "{backend} standing for vtk or pygfx", type="linelist", default=[])
+    group.addoption("--conformance-app-ticks", dest="conformance_app_ticks", default=None, metavar="N",
+                    help="ticks of each app's own run (default 120)")
+    parser.addini("conformance_app_ticks", "default for --conformance-app-ticks", default=None)
     from conformance import image_options
 
     image_options.add_options(group, parser)
@@ -108,12 +115,52 @@ def _sync_spec(config: pytest.Config) -> str:
         raise pytest.UsageError(str(err)) from None
 
 
+def app_paths(config: pytest.Config) -> list:
+    """The apps to check (``--conformance-app``, else the ini ``conformance_apps``), as paths; a pattern that
+    matches nothing, or a path that is not a file, is a usage error naming it."""
+    from pathlib import Path
+
+    given = config.getoption("conformance_app")
+    if given:
+        missing = [g for g in given if not Path(g).is_file()]
+        if missing:
+            raise pytest.UsageError(f"--conformance-app={missing[0]!r}: no such file; give the path of an app's script")
+        return [Path(g).resolve() for g in given]
+    patterns = config.getini("conformance_apps")
+    if not patterns:
+        return []
+    from conformance import backends
+
+    found = []
+    for pattern in patterns:
+        pattern = pattern.replace("{backend}", backends.NAME)
+        matches = sorted(p for p in config.rootpath.glob(pattern) if p.is_file())
+        if not matches:
+            raise pytest.UsageError(f"ini conformance_apps: {pattern!r} matches no file under {config.rootpath}")
+        found.extend(matches)
+    return list(dict.fromkeys(found))
+
+
+def app_ticks(config: pytest.Config) -> int:
+    from conformance import apps, validation
+    from conformance.errors import BadArgument
+
+    value = config.getoption("conformance_app_ticks") or config.getini("conformance_app_ticks")
+    if not value:
+        return apps.DEFAULT_TICKS
+    try:
+        return validation.whole_number("--conformance-app-ticks", value, low=1, high=validation.MAX_STEPS)
+    except BadArgument as err:
+        raise pytest.UsageError(str(err)) from None
+
+
 def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line("markers", "scene(name): the reference scene a conformance check runs on")
     config.addinivalue_line("markers", "sync: a check that runs the sync implementation under test (added automatically)")
     # pytest-xdist registers it itself; without xdist installed the kit's grouping of a scene's checks
     # would otherwise warn as an unknown mark in every run.
     config.addinivalue_line("markers", "xdist_group(name): checks pytest-xdist runs in one worker (one scene's)")
+    app_paths(config), app_ticks(config)  # a missing app or a bad tick count stops the run before collection
     config.stash[_VERDICT_KEY] = defaultdict(lambda: defaultdict(list))
     if getattr(config.option, "dist", "no") == "load":
         # -n's default scheduling, with groups: the checks of one scene (marked below) go to one
@@ -168,6 +215,11 @@ def pytest_collection_modifyitems(session: pytest.Session, config: pytest.Config
     before any check runs, if any collected check needs it."""
     from conformance import ordering
 
+    placeholders = [item for item in items if getattr(item, "callspec", None) is not None
+                    and "app" in item.callspec.params and item.callspec.params["app"] is None]
+    if placeholders:  # no app configured: the app checks are not collected at all
+        items[:] = [item for item in items if item not in placeholders]
+        config.hook.pytest_deselected(items=placeholders)
     uses_sync = [item for item in items if "sync_implementation" in getattr(item, "fixturenames", ())]
     for item in uses_sync:
         item.add_marker(pytest.mark.sync)

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from hypothesis import HealthCheck, Phase, settings
 
-__all__ = ["CI_FACTOR", "check_settings", "describe"]
+__all__ = ["CI_FACTOR", "app_examples", "check_settings", "describe"]
 
 CI_FACTOR = 4
 _SLOW_OK = [HealthCheck.too_slow, HealthCheck.data_too_large, HealthCheck.filter_too_much]
@@ -39,6 +39,16 @@ def check_settings(examples: int) -> settings:
     else:
         count = settings.default.max_examples
     return settings(max_examples=count, deadline=None, suppress_health_check=_SLOW_OK, print_blob=True)
+
+
+#: Perturbed runs of an app per profile: each is a whole run of the app in its own process (seconds), so
+#: not a multiple of the scene checks' examples.
+_APP_EXAMPLES = {"default": 2, "ci": 3, "triage": 2}
+
+
+def app_examples() -> int:
+    """How many perturbed runs ``test_app_perturbed`` makes of each app under the current profile."""
+    return _APP_EXAMPLES.get(_profile(), settings.default.max_examples)
 
 
 def describe() -> str:

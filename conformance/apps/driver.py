@@ -36,11 +36,11 @@ class AppLoopNotFound(ConformanceError):
 
 HOW_TO_EXPOSE = (
     "The kit drives an app through FURY's own loop: on FURY 0.12 a function registered with "
-    "`showm.add_timer_callback(True, ms, callback)` (or a TimerEvent observer on `showm.iren`), on FURY 2 one "
+    "`showm.add_timer_callback(True, ms, callback)`, on FURY 2 one "
     "registered with `showm.register_callback(callback, seconds, True, name)`, run once a tick when the app calls "
     "`showm.start()`, `window.show(...)` or `window.record(...)`/`window.snapshot(...)`, or when it disconnects "
     "pyBullet. If your program steps and syncs in a loop of its own, put one frame of it (step, then sync) in a "
-    "module-level function and name it with `--tick NAME` (pytest: `conformance_app_tick = NAME`)."
+    "module-level function and name it: `python -m conformance app PATH --tick NAME`."
 )
 
 
@@ -113,6 +113,7 @@ class Driver:
         self._frames: list[bodies.Frame] = []
         self._before = None
         self._steps = 0
+        self._tick = 0
 
     # -- what the patches call ------------------------------------------------------------------
     def offer(self, source) -> None:
@@ -132,6 +133,12 @@ class Driver:
         if not self.finished and self._source() is not None:
             self.entry = "p.disconnect()"
             self.run()
+
+    def raised(self, exc: BaseException) -> None:
+        """The app's callback raised (and its window would go on): keep the first, with where it was."""
+        if self.error is None:
+            self.error = (f"the app raised at tick {self._tick}: {type(exc).__name__}: {exc}\n"
+                          + "".join(traceback.format_exception(exc)[-6:]))
 
     def before_step(self) -> None:
         if self._frames:
@@ -185,6 +192,7 @@ class Driver:
 
         try:
             for tick in range(1, self.ticks + 1):
+                self._tick = tick
                 perturb.apply(self.events, tick, clients[0], self._frames)
                 self._steps = 0
                 self._before = None
@@ -195,8 +203,7 @@ class Driver:
                     ended = f"{source.ended()} after tick {tick}"
                     break
         except Exception as exc:  # the app's own code raised inside its callback: that is a verdict
-            self.error = (f"the app raised at tick {len(steps)}: {type(exc).__name__}: {exc}\n"
-                          + "".join(traceback.format_exception(exc)[-6:]))
+            self.raised(exc)
             ended = f"the app raised at tick {len(steps)}"
         notes = []
         if source.actors() and len(source.actors()) != len(actors):

@@ -102,12 +102,11 @@ class _Judgement:
             for start, stop in _runs(loose, np.zeros(len(loose), dtype=int)):
                 verdict.passed = False
                 rows = np.arange(start, stop)
-                frame = self._followed(track.vertices[1:, rows], a.frame[rows])
+                frame, diagnosis = self._followed(track.vertices[1:, rows], a.frame[rows], a.reference[rows])
                 error, allowance = self._errors(track.vertices[1:, rows], frame)
                 bad_ticks = np.flatnonzero(np.any(error > allowance[:, None], axis=0))
                 first = int(bad_ticks[0]) if len(bad_ticks) else 0
                 k = int(np.argmax(error.max(axis=0)))
-                diagnosis = self._diagnose(track.vertices[1:, rows], frame, a.reference[rows], allowance, bad_ticks)
                 self.followed_badly.add(frame)
                 verdict.lines.append(
                     f"{track.label} ({track.kind}) vertices {start}:{stop} of {len(a.frame)}: not held by any frame; "
@@ -120,15 +119,25 @@ class _Judgement:
         verdict.worst = worst
         return verdict
 
-    def _followed(self, vertices, candidates) -> int:
-        """The frame a run of loose vertices follows best: of the frames its vertices were nearest to
-        holding, the one with the smallest median error over the run (bodies before the world)."""
-        best, best_error = -1, np.inf
-        for frame in [int(f) for f in np.unique(candidates) if f >= 0] or [-1]:
-            error, _ = self._errors(vertices, frame)
-            if np.median(error) < best_error:
-                best, best_error = frame, float(np.median(error))
-        return best
+    def _followed(self, vertices, best, reference) -> tuple[int, str]:
+        """The frame a run of loose vertices follows, and the mistake that explains it if one does: of
+        the frames its vertices came nearest to being held by and the four frames nearest to the run,
+        the first whose pose under a known mistake holds the run; else the one with the smallest median
+        error (the world only when no body does better)."""
+        centre = vertices[0].mean(axis=0)
+        nearest = np.argsort(np.linalg.norm(self.pos[0] - centre, axis=1))[:4] if self.pos.shape[1] else []
+        candidates = list(dict.fromkeys([int(f) for f in np.unique(best) if f >= 0] + [int(f) for f in nearest]))
+        scored = []
+        for frame in candidates:
+            error, allowance = self._errors(vertices, frame)
+            bad_ticks = np.flatnonzero(np.any(error > allowance[:, None], axis=0))
+            diagnosis = self._diagnose(vertices, frame, reference, allowance, bad_ticks)
+            if diagnosis:
+                return frame, diagnosis
+            scored.append((float(np.median(error)), frame))
+        world, _ = self._errors(vertices, -1)
+        scored.append((float(np.median(world)) + 1e-12, -1))
+        return min(scored)[1], ""
 
     def _errors(self, vertices, frame: int):
         """Error ``(m, T)`` and allowance ``(m,)`` of vertices ``(T, m, 3)`` held by ``frame``."""

@@ -1,7 +1,6 @@
 """Taking over FURY 0.12's window loop (VTK).
 
-A FURY 0.12 app registers its per-frame function with ``ShowManager.add_timer_callback`` (or straight
-on the interactor, ``showm.iren.AddObserver("TimerEvent", f)``) and hands control to
+A FURY 0.12 app registers its per-frame function with ``ShowManager.add_timer_callback`` and hands control to
 ``showm.start()``, ``window.show`` or, when not interactive, ``window.record``. The kit leaves
 ``add_timer_callback``, ``render`` and ``exit`` as FURY wrote them (the window is off-screen, on the
 kit's X display) and replaces only the calls that would wait for a person: ``start``, ``show`` and
@@ -22,10 +21,10 @@ class _Source:
 
     def __init__(self, showm):
         self.showm = showm
+        self.timers = 0  # add_timer_callback calls (VTK's interactor style observes TimerEvent itself)
 
     def ready(self) -> bool:
-        iren = getattr(self.showm, "iren", None)
-        return iren is not None and bool(iren.HasObserver("TimerEvent"))
+        return self.timers > 0 and getattr(self.showm, "iren", None) is not None
 
     def tick(self) -> None:
         self.showm.iren.InvokeEvent("TimerEvent")
@@ -37,7 +36,7 @@ class _Source:
         return scene_actors(self.showm.scene)
 
     def describe(self) -> str:
-        return "FURY 0.12 ShowManager: its TimerEvent observers (add_timer_callback), once a tick"
+        return "FURY 0.12 ShowManager: its add_timer_callback functions (every TimerEvent observer), once a tick"
 
     def ended(self) -> str:
         return "the app called showm.exit()"
@@ -62,11 +61,26 @@ def install(driver) -> None:
     from fury import window
 
     original_init = window.ShowManager.__init__
+    original_add = window.ShowManager.add_timer_callback
 
     def __init__(self, *args, **kwargs):
         original_init(self, *args, **kwargs)
         self.window.SetOffScreenRendering(1)  # drawn on the kit's display, never mapped
-        driver.offer(_Source(self))
+        self._kit_source = _Source(self)
+        driver.offer(self._kit_source)
+
+    def add_timer_callback(self, repeat, duration, timer_callback):
+        self._kit_source.timers += 1
+
+        def observed(obj, event):
+            # VTK prints an exception raised in an observer and goes on; the kit notes it as a verdict too
+            try:
+                return timer_callback(obj, event)
+            except Exception as exc:
+                driver.raised(exc)
+                raise
+
+        return original_add(self, repeat, duration, observed)
 
     def start(self, *args, **kwargs):
         driver.reached("showm.start()")
@@ -78,6 +92,7 @@ def install(driver) -> None:
         driver.reached("window.record()")  # the app's picture file is not written
 
     window.ShowManager.__init__ = __init__
+    window.ShowManager.add_timer_callback = add_timer_callback
     window.ShowManager.start = start
     window.show = show
     window.record = record

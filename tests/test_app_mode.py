@@ -1,0 +1,110 @@
+"""App mode end to end, on the installed FURY: ``python -m conformance app`` and the pytest checks run a
+small app unmodified in its own process, accept it, and reject copies with one mistake each, naming
+it; apps the kit cannot drive, that raise, crash or hang get one paragraph each."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+
+from conformance import apps, backends
+from conformance.apps import launch
+
+APP = Path(__file__).parent / "apps" / f"box_{backends.NAME}.py"
+SOURCE = APP.read_text(encoding="utf-8")
+STEP = "    p.stepSimulation()\n"
+
+
+def _copy(tmp_path, text, name="app.py") -> Path:
+    path = tmp_path / name
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def _cli(*args):
+    return subprocess.run([sys.executable, "-m", "conformance", "app", *map(str, args)], capture_output=True, text=True,
+                          timeout=600)
+
+
+def test_a_right_app_passes_every_check_and_its_perturbed_runs():
+    done = _cli(APP, "--perturbed", "1")
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "verdict: PASS" in done.stdout and "PASS perturbed" in done.stdout
+
+
+def test_an_app_that_syncs_before_it_steps_is_one_step_late(tmp_path):
+    late = SOURCE.replace(STEP, "").replace("    showm.render()\n", "    showm.render()\n" + STEP)
+    assert late != SOURCE
+    done = _cli(_copy(tmp_path, late), "--perturbed", "0")
+    assert done.returncode == 1
+    assert "FAIL attached" in done.stdout and "previous step" in done.stdout
+    assert "reproduce: python -m conformance app" in done.stdout
+
+
+def test_an_app_that_never_moves_its_actor_leaves_its_body_undrawn(tmp_path):
+    setter = "ball_actor.SetUserMatrix(u)" if backends.NAME == "vtk" else "box.local.rotation = orn"
+    never = SOURCE.replace(setter, "pass")
+    if backends.NAME == "pygfx":
+        never = never.replace("box.local.position = pos", "pass")
+    result = apps.check_app(_copy(tmp_path, never), ticks=30)
+    assert not result.verdicts["drawn"].passed
+    assert "body 0 base" in result.verdicts["drawn"].message()
+
+
+@pytest.mark.parametrize("change, needle", [
+    (lambda s: s.replace("showm.start()", "pass").replace("p.disconnect()", "pass"),
+     "without registering a per-frame function"),
+    (lambda s: s.replace("scene = window.Scene()", "scene = window.Scene()\nraise ValueError('no scene today')"),
+     "the app raised before its loop ran: ValueError: no scene today"),
+    (lambda s: s.replace(STEP, STEP + "    import os; os._exit(7) if cnt == 3 else None\n"),
+     "exited with status 7"),
+    (lambda s: s.replace(STEP, STEP + "    import ctypes; ctypes.string_at(0) if cnt == 3 else None\n"),
+     "killed by signal"),
+])
+def test_an_app_the_kit_cannot_run_gets_one_paragraph(tmp_path, change, needle):
+    text = change(SOURCE)
+    assert text != SOURCE
+    if "without registering" in needle:  # no callback at all: the app only builds its scene
+        text = text.replace("showm.add_timer_callback(True, 1, timer_callback)", "pass").replace(
+            'showm.register_callback(timer_callback, 1 / 240, True, "physics")', "pass") + "\nshowm.start()\n"
+    with pytest.raises(apps.AppFailed) as err:
+        apps.check_app(_copy(tmp_path, text), ticks=10)
+    message = str(err.value)
+    assert needle in message, message
+    assert "Traceback (most recent call last)" not in message.split("\n")[0]
+
+
+def test_an_app_that_hangs_is_stopped_at_the_timeout(tmp_path):
+    hangs = SOURCE.replace(STEP, STEP + "    import time; time.sleep(600) if cnt == 2 else None\n")
+    with pytest.raises(apps.AppFailed, match="did not finish 10 ticks within 20 s"):
+        launch.record(_copy(tmp_path, hangs), ticks=10, timeout=20)
+
+
+def test_an_app_raising_in_its_callback_fails_runs(tmp_path):
+    raises = SOURCE.replace(STEP, STEP + "    if cnt == 4:\n        raise RuntimeError('lost the body')\n")
+    result = apps.check_app(_copy(tmp_path, raises), ticks=20)
+    assert not result.verdicts["runs"].passed
+    assert "the app raised at tick 5: RuntimeError: lost the body" in result.verdicts["runs"].message()
+
+
+def test_apps_in_the_ini_are_checked_one_id_per_check(pytester):
+    pytester.makefile(".py", app=SOURCE)
+    pytester.makeini(textwrap.dedent("""\
+        [pytest]
+        conformance_apps = app.py
+        conformance_app_ticks = 20
+    """))
+    result = pytester.runpytest_subprocess("--pyargs", "conformance.test_apps", "-p", "no:cacheprovider",
+                                           "--hypothesis-profile", "triage", "-q")
+    result.assert_outcomes(passed=len(apps.CHECKS) + 1)
+    result.stdout.fnmatch_lines(["*PASS  app:app.py*"])
+
+
+def test_a_missing_app_is_a_usage_error(pytester):
+    result = pytester.runpytest_subprocess("--pyargs", "conformance.test_apps", "--conformance-app", "nowhere.py")
+    assert result.ret == pytest.ExitCode.USAGE_ERROR
+    result.stderr.fnmatch_lines(["*--conformance-app='nowhere.py': no such file*"])
