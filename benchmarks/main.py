@@ -9,12 +9,14 @@ from typing import Callable
 
 from conformance.progress import progress
 
-from . import machine, pictures, reads, suite, syncs, targets
+from . import app_mode, machine, pictures, reads, suite, syncs, targets
 
-__all__ = ["PARTS", "Options", "Results", "run"]
+__all__ = ["DEFAULT_PARTS", "PARTS", "Options", "Results", "run"]
 
-#: What a run measures unless told otherwise; ``suite`` (minutes) only when asked.
-PARTS = ("syncs", "reads", "pictures")
+#: What a run can measure (``--only``); ``apps`` (app mode's cost, a minute or two) and ``suite``
+#: (minutes) only when asked.
+PARTS = ("syncs", "reads", "pictures", "apps")
+DEFAULT_PARTS = ("syncs", "reads", "pictures")
 
 
 @dataclass(frozen=True)
@@ -22,7 +24,7 @@ class Options:
     sizes: tuple[int, ...] = (100, 1_000, 10_000)
     repeats: int = 15
     subject: str = "reference"  # the sync the targets judge
-    parts: tuple[str, ...] = PARTS
+    parts: tuple[str, ...] = DEFAULT_PARTS
     suite: bool = False
     suite_repeats: int = 1
     picture_scenes: tuple[str, ...] = pictures.SCENES
@@ -61,6 +63,7 @@ class Results:
     reads: list = field(default_factory=list)
     pictures: list = field(default_factory=list)
     suite: list = field(default_factory=list)
+    apps: list = field(default_factory=list)
     renderer: dict = field(default_factory=dict)
 
 
@@ -79,6 +82,12 @@ def _tasks(options: Options, results: Results) -> list[Callable[[], None]]:
         tasks.append(lambda: results.renderer.update(backends.renderer_info()))
         for name in options.picture_scenes:
             tasks.append(lambda n=name: results.pictures.extend(pictures.measure(n, repeats=options.repeats)))
+    if "apps" in options.parts:
+        from conformance import backends
+
+        for name, script, environment in app_mode.apps(backends.NAME):
+            tasks.append(lambda n=name, s=script, e=environment: results.apps.append(
+                app_mode.measure(n, s, e, repeats=min(options.repeats, 3))))
     if options.suite:
         tasks.append(lambda: results.suite.extend(suite.measure(repeats=options.suite_repeats, baseline_repeats=3)))
     return tasks

@@ -5,7 +5,7 @@ from __future__ import annotations
 import dataclasses
 import json
 
-from . import floor, machine, pictures, reads, suite, syncs
+from . import app_mode, floor, machine, pictures, reads, suite, syncs
 from .main import Results
 
 __all__ = ["as_json", "markdown"]
@@ -104,6 +104,14 @@ def _suite_table(results: Results) -> list[str]:
     return lines
 
 
+def _apps_table(results: Results) -> list[str]:
+    lines = ["| app | ticks | the app's own tick | recording | judging | kit ÷ app |", "|---|---|---|---|---|---|"]
+    for f in results.apps:
+        lines.append(f"| {f.name} | {f.ticks} | {f.baseline * 1e3:.1f} ms | {f.record * 1e3:.1f} ms | "
+                     f"{f.judge * 1e3:.1f} ms | {_ratio(f.ratio)} |")
+    return lines
+
+
 def markdown(results: Results) -> str:
     """The tables, each introduced by what its figures are ratios to."""
     o = results.options
@@ -126,6 +134,10 @@ def markdown(results: Results) -> str:
         out += ["", "**Pictures** at the scenes' own size (drawn by the GPU named above), as a ratio to "
                 f"{pictures.FRAME.split(': ', 1)[0]} of the same scene ({pictures.FRAME.split(': ', 1)[1]}; its own time given):",
                 ""] + _pictures_table(results)
+    if results.apps:
+        out += ["", f"**App mode** (`python -m conformance app`, {app_mode.TICKS} ticks, best of "
+                f"{min(o.repeats, 3)} runs), per tick, as a ratio to the app's own tick in the same run (its callbacks: "
+                "step, sync, render):", ""] + _apps_table(results)
     if results.suite:
         out += ["", f"**Whole runs** (subprocesses, best of {o.suite_repeats}), as a ratio to {suite.BASELINE}:", ""]
         out += _suite_table(results)
@@ -145,4 +157,5 @@ def as_json(results: Results) -> str:
         "reads": [f.as_dict() for f in results.reads],
         "pictures": [f.as_dict() for f in results.pictures],
         "suite": [f.as_dict() for f in results.suite],
+        "apps": [f.as_dict() for f in results.apps],
     }, indent=2)

@@ -31,6 +31,7 @@ def test_float32_storage_is_within_the_allowance():
     ("previous-step", "attached", "previous-step"),
     ("conjugate", "attached", "conjugate"),
     ("wxyz", "attached", "wxyz"),
+    ("scalar-first", "attached", "scalar-first"),
     ("translation-only", "attached", "translation-only"),
     ("never-moved", "drawn", "never-moved"),
     ("unannounced", "announced", "unannounced"),
@@ -45,6 +46,8 @@ def test_a_known_mistake_fails_with_its_diagnosis(mistake, check, diagnosis):
         drawn = draw(pos, Rotation.from_quat(orn).inv().as_quat())
     elif mistake == "wxyz":
         drawn = draw(pos, np.roll(orn, 1, axis=1))
+    elif mistake == "scalar-first":
+        drawn = draw(pos, Rotation.from_quat(orn, scalar_first=True).as_quat())
     elif mistake == "translation-only":
         drawn = draw(pos, np.tile(orn[:1], (len(orn), 1)))
     elif mistake == "never-moved":

@@ -7,6 +7,7 @@ from __future__ import annotations
 import json
 import sys
 import time
+from pathlib import Path
 
 import pybullet
 import pytest
@@ -15,7 +16,7 @@ from conformance import backends, cli
 from conformance.commands import bench as bench_command
 
 bench_command.benchmarks()  # the checkout's benchmarks/ on sys.path
-from benchmarks import floor, grid, pictures, report, suite, syncs, targets, timing  # noqa: E402
+from benchmarks import app_mode, floor, grid, pictures, report, suite, syncs, targets, timing  # noqa: E402
 from benchmarks.main import Options, Results  # noqa: E402
 from conformance.implementations.reference import ReferenceSync  # noqa: E402
 
@@ -272,3 +273,14 @@ def _machine():
     from benchmarks import machine
 
     return machine.machine()
+
+
+def test_app_mode_figures_are_per_tick_against_the_apps_own_tick():
+    app = Path(__file__).resolve().parent.parent / "benchmarks" / "apps" / f"boxes_{backends.NAME}.py"
+    figure = app_mode.measure("boxes", app, {"BENCH_BODIES": "27", "BENCH_TICKS": "10"}, repeats=1, ticks=20)
+    assert figure.ticks == 10  # the app ends itself
+    assert figure.baseline > 0 and figure.record > 0 and figure.judge > 0
+    assert figure.seconds == pytest.approx(figure.record + figure.judge) and figure.ratio == figure.seconds / figure.baseline
+    text = report.markdown(Results(options=Options(parts=()), machine=_machine(), started="now", apps=[figure]))
+    assert "**App mode**" in text and "| boxes | 10 |" in text
+    assert [name for name, _, _ in app_mode.apps(backends.NAME)][-1].startswith("1,000 boxes in one actor")

@@ -158,8 +158,12 @@ VARIANTS = {
     "conjugate": ("drawn with the inverse (conjugate, or transposed-matrix) rotation: a row-vector `v @ R` where "
                   "`R @ v` was meant, or a matrix written transposed",
                   lambda p, q, bp, bq: (p, np.swapaxes(_rotations(q), -1, -2))),
-    "wxyz": ("drawn with the quaternion's components in (w, x, y, z) order read as pyBullet's (x, y, z, w)",
+    "wxyz": ("drawn with the quaternion reordered to (w, x, y, z) and handed to something that takes pyBullet's "
+             "(x, y, z, w), as pygfx's local.rotation does: pass pyBullet's quaternion as it is",
              lambda p, q, bp, bq: (p, _rotations(np.roll(q, 1, axis=-1)))),
+    "scalar-first": ("drawn with pyBullet's (x, y, z, w) quaternion read as (w, x, y, z) (scalar first: transforms3d, "
+                     "Eigen, scipy's scalar_first=True): read it as (x, y, z, w)",
+                     lambda p, q, bp, bq: (p, _rotations(np.roll(q, -1, axis=-1)))),
     "euler-order": ("drawn with pyBullet's Euler angles applied in VTK's order (SetOrientation turns about z, then x, "
                     "then y; getEulerFromQuaternion's angles are about fixed x, y, z): set a matrix from the quaternion",
                     lambda p, q, bp, bq: (p, _vtk_euler(q))),

@@ -17,6 +17,7 @@ as it does to its scenes: that is what makes the judgement property-based on an 
 from __future__ import annotations
 
 import sys
+import time
 import traceback
 from types import SimpleNamespace
 
@@ -114,6 +115,7 @@ class Driver:
         self._before = None
         self._steps = 0
         self._tick = 0
+        self._reading = 0.0  # seconds of the kit's reads inside the app's ticks (before each step)
 
     # -- what the patches call ------------------------------------------------------------------
     def offer(self, source) -> None:
@@ -142,8 +144,10 @@ class Driver:
 
     def before_step(self) -> None:
         if self._frames:
+            start = time.perf_counter()
             self._before = bodies.read_poses(self._frames)
             self._steps += 1
+            self._reading += time.perf_counter() - start
 
     # -- the loop --------------------------------------------------------------------------------
     def _source(self):
@@ -188,6 +192,7 @@ class Driver:
         snapshot()
         steps.append(0)
         ended = f"the kit's tick limit ({self.ticks})"
+        in_ticks = in_snapshots = 0.0
         from conformance.apps import perturb
 
         try:
@@ -196,8 +201,11 @@ class Driver:
                 perturb.apply(self.events, tick, clients[0], self._frames)
                 self._steps = 0
                 self._before = None
+                start = time.perf_counter()
                 source.tick()
+                middle = time.perf_counter()
                 snapshot()
+                in_ticks, in_snapshots = in_ticks + middle - start, in_snapshots + time.perf_counter() - middle
                 steps.append(self._steps)
                 if source.done():
                     ended = f"{source.ended()} after tick {tick}"
@@ -214,7 +222,8 @@ class Driver:
             frames=self._frames, positions=np.array(end_pos), orientations=np.array(end_orn),
             before_positions=np.array(before_pos), before_orientations=np.array(before_orn),
             steps=np.array(steps, dtype=np.int64), loop=f"{source.describe()} (handed over at {self.entry or 'the end of the script'})",
-            ended=ended, events=[perturb.as_dict(e) for e in self.events], notes=notes)
+            ended=ended, events=[perturb.as_dict(e) for e in self.events], notes=notes,
+            seconds={"app": in_ticks - self._reading, "record": in_snapshots + self._reading})
 
 
 class _Track:
@@ -241,6 +250,7 @@ class _Track:
             self.changed.append(state[1] != self._state[1])
             self.announced.append(state[0] != self._state[0])
         self._state = state
+        self.backend.hand_over(self.actor)  # as the window's next frame would, so the next tick starts clean
 
     def result(self, ticks: int) -> ActorTrack:
         kind = type(self.actor).__name__

@@ -196,8 +196,10 @@ class _Judgement:
     def _left_behind(self, index: int) -> str:
         """An actor range held by the world that sits on this frame as it was at the start."""
         radius = bounding_radius(self.r.frames[index].shapes)
+        # A frame that never moves holds what the world holds (a static ground plate): either may be named.
+        still = [i for i, f in enumerate(self.r.frames) if self._movement(i, bounding_radius(f.shapes) if f.shapes else 0.0) == 0.0]
         for track, a in zip(self.r.actors, self.attachments):
-            world = np.flatnonzero((a.frame < 0) & a.held)
+            world = np.flatnonzero(((a.frame < 0) | np.isin(a.frame, still)) & a.held)
             if not len(world):
                 continue
             for start, stop in _runs(np.isin(np.arange(len(a.frame)), world), a.frame):

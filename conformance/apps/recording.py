@@ -56,6 +56,9 @@ class Recording:
     events: list = field(default_factory=list)
     notes: list = field(default_factory=list)
     error: str = ""             # the app raised inside its loop: what and where
+    #: seconds spent in the app's own ticks (its callbacks: steps, sync, render) and in the kit's reads
+    #: and records around them, over the whole run (the cost benchmark's figures)
+    seconds: dict = field(default_factory=dict)
 
     @property
     def ticks(self) -> int:
@@ -78,7 +81,7 @@ def save(recording: Recording, path) -> None:
     meta = {"script": recording.script, "backend": recording.backend, "actors": actors,
             "frames": [f.as_dict() for f in recording.frames], "loop": recording.loop, "ended": recording.ended,
             "events": recording.events, "notes": recording.notes,
-            "error": recording.error}
+            "error": recording.error, "seconds": recording.seconds}
     arrays["meta"] = np.frombuffer(json.dumps(meta).encode("utf-8"), dtype=np.uint8)
     buffer = io.BytesIO()
     np.savez(buffer, **arrays)
@@ -101,4 +104,5 @@ def load(path) -> Recording:
         return Recording(meta["script"], meta["backend"], actors, [_frame(f) for f in meta["frames"]],
                          data["positions"], data["orientations"], data["before_positions"],
                          data["before_orientations"], data["steps"], meta["loop"], meta["ended"],
-                         meta["events"], meta["notes"], meta.get("error", ""))
+                         meta["events"], meta["notes"], meta.get("error", ""),
+                         meta.get("seconds", {}))

@@ -9,6 +9,7 @@ one of them). The rest of the kit talks to a backend only through these names:
 * ``world_vertices(actor) -> (n, 3)``: what the renderer will draw, in world coordinates;
 * ``world_normals(actor)``: the stored vertex normals as they will be lit, or None;
 * ``mesh_signature(actor)``: vertex count, topology and colours, to check a sync keeps the mesh;
+* ``hand_over(actor)``: take its announced changes as a window's next frame would (app mode, after every tick);
 * ``content_state(actor)``: a change counter and a copy of the data, to check changes are announced
   (VTK's ``Modified()``, pygfx's ``update_range``/``update_full``);
 * ``content_time(actor)``: the change counter alone (cheap);
@@ -32,7 +33,7 @@ import importlib.metadata
 
 from conformance.errors import BackendError
 
-__all__ = ["ANNOUNCE", "LIGHTING", "MULTISAMPLES", "NAME", "NAMES", "Drawing", "build", "content_state", "content_time", "describe", "flush", "fury_version", "mesh_signature", "perturbed",
+__all__ = ["ANNOUNCE", "LIGHTING", "MULTISAMPLES", "NAME", "NAMES", "Drawing", "build", "content_state", "content_time", "describe", "flush", "fury_version", "hand_over", "mesh_signature", "perturbed",
            "render", "render_ids", "renderer_info", "renderer_label", "world_normals", "world_vertices"]
 
 #: Backend names and the FURY each one is: the ``./kit --backend`` values and ``golden/<name>/``.

@@ -27,7 +27,7 @@ import numpy as np
 from conformance.backends.common import Drawing, decode_ids, id_codes, lay_out, moved_range, transformed, turned_normals
 from conformance.errors import BackendError
 
-__all__ = ["ANNOUNCE", "LIGHTING", "MULTISAMPLES", "NAME", "Drawing", "build", "content_state", "content_time", "flush", "mesh_signature", "perturbed", "render", "render_ids",
+__all__ = ["ANNOUNCE", "LIGHTING", "MULTISAMPLES", "NAME", "Drawing", "build", "content_state", "content_time", "flush", "hand_over", "mesh_signature", "perturbed", "render", "render_ids",
            "renderer_info", "world_normals", "world_vertices"]
 
 NAME = "pygfx"
@@ -171,6 +171,16 @@ def world_normals(actor) -> np.ndarray | None:
 def _buffers(actor) -> list:
     geometry = actor.geometry
     return [b for b in (geometry.positions, getattr(geometry, "normals", None)) if b is not None]
+
+
+def hand_over(actor) -> None:
+    """Take the actor's announced changes as a live window's next frame does, without drawing: pygfx's
+    renderer asks each buffer for its pending ranges (``_gfx_get_chunk_descriptions``, which clears them)
+    and uploads them. Until that happens a buffer stays "wholly pending" and further ``update_range``
+    calls do not move its revision, so a change announced every frame would look unannounced. App mode
+    calls this after every tick, where the app's own window does not draw."""
+    for buffer in _buffers(actor):
+        buffer._gfx_get_chunk_descriptions()
 
 
 def content_time(actor) -> int:

@@ -18,7 +18,7 @@ from conformance.backends.common import Drawing, decode_ids, id_codes, lay_out, 
 from conformance.display import close_x_connection, ensure_display, on_stop, x_connection
 from conformance.errors import SceneError
 
-__all__ = ["ANNOUNCE", "LIGHTING", "MULTISAMPLES", "NAME", "Drawing", "build", "content_state", "content_time", "flush", "mesh_signature", "perturbed", "render", "render_ids", "renderer_info", "world_normals", "world_vertices"]
+__all__ = ["ANNOUNCE", "LIGHTING", "MULTISAMPLES", "NAME", "Drawing", "build", "content_state", "content_time", "flush", "hand_over", "mesh_signature", "perturbed", "render", "render_ids", "renderer_info", "world_normals", "world_vertices"]
 
 
 def _fury_actor(kind: str, centers: np.ndarray, colors: np.ndarray, sizes: np.ndarray):
@@ -137,6 +137,10 @@ def world_normals(actor) -> np.ndarray | None:
 def content_time(actor) -> int:
     """The modification time of the actor's data alone (the first half of :func:`content_state`)."""
     return actor.GetMapper().GetInput().GetMTime()
+
+
+def hand_over(actor) -> None:
+    """Nothing to take: VTK's modification times only grow, so every announcement shows (see pygfx's)."""
 
 
 def content_state(actor) -> tuple[int, bytes]:

@@ -44,8 +44,9 @@ def add_arguments(parser) -> None:
                         help="rounds per figure; each figure is the best round (default 15)")
     parser.add_argument("--sync", dest="sync_given", default=None,
                         help="the sync implementation the targets judge (short name or module:attribute; default reference)")
-    parser.add_argument("--only", nargs="+", choices=["syncs", "reads", "pictures"], default=None,
-                        help="measure only these parts (default: all three)")
+    parser.add_argument("--only", nargs="+", choices=["syncs", "reads", "pictures", "apps"], default=None,
+                        help="measure only these parts (default: syncs, reads and pictures; apps: app mode's cost "
+                             "per tick against the app's own)")
     parser.add_argument("--suite", action="store_true",
                         help="also time whole runs as subprocesses: pytest conformance, serial and with -n 2, "
                              "and ./kit test (minutes)")
@@ -65,7 +66,7 @@ def run(args, extra) -> int:
 
     try:
         options = main.Options(sizes=tuple(args.sizes), repeats=args.repeats, subject=resolve_sync(args.sync_given),
-                               parts=tuple(args.only or main.PARTS), suite=args.suite, suite_repeats=args.suite_repeats)
+                               parts=tuple(args.only or main.DEFAULT_PARTS), suite=args.suite, suite_repeats=args.suite_repeats)
     except ValueError as exc:
         raise ConformanceError(str(exc)) from None
     if args.readme:

@@ -1,5 +1,8 @@
 """A small right app (FURY 0.12): one tumbling box, whole actor, posed every tick after the step. The kit's
-tests copy it with one line changed to make wrong ones (tests/test_app_mode.py)."""
+tests copy it with one line changed to make wrong ones (tests/test_app_mode.py).
+
+EXPECT: pass
+"""
 import itertools
 import numpy as np
 import pybullet as p

@@ -1,0 +1,75 @@
+"""App mode's cost: what recording and judging an app add to each of its ticks, against the app's own tick.
+
+The baseline is the app's own work in the same run and process: the time inside its per-frame callbacks
+(its ``stepSimulation``, its sync, its ``showm.render()``), less the kit's reads made inside them. Against
+it: the kit's recording per tick (reading every link frame before each step and after each tick, every
+actor's vertices and normals through its matrix, the announcements), measured in the app's process, and
+the judgement per tick (:func:`conformance.apps.judge` on the recording, in the kit's process). Each app is
+run once per round as ``python -m conformance app`` runs it; a figure is the best round.
+
+Apps: the guide-sized brick wall of ``examples/`` (101 bodies, one actor each, and one shared actor), and
+``benchmarks/apps/boxes_BACKEND.py``, 1,000 boxes in one actor.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from .timing import RatioToBaseline
+
+__all__ = ["AppFigure", "apps", "measure"]
+
+ROOT = Path(__file__).resolve().parent.parent
+TICKS = 60
+
+
+@dataclass(frozen=True)
+class AppFigure(RatioToBaseline):
+    """Per tick: ``seconds`` the kit adds (recording + judging), ``baseline`` the app's own tick."""
+
+    name: str
+    ticks: int
+    seconds: float
+    baseline: float
+    record: float
+    judge: float
+
+
+def apps(backend: str) -> list[tuple[str, Path, dict]]:
+    """(name, script, environment) of each app measured, on ``backend``."""
+    examples = ROOT / "examples" / backend
+    return [(f"guide brick wall, one actor a body (`examples/{backend}/brick_wall.py`)", examples / "brick_wall.py", {}),
+            (f"guide brick wall, bricks in one actor (`examples/{backend}/brick_wall_single.py`)",
+             examples / "brick_wall_single.py", {}),
+            (f"1,000 boxes in one actor (`benchmarks/apps/boxes_{backend}.py`)",
+             ROOT / "benchmarks" / "apps" / f"boxes_{backend}.py", {"BENCH_BODIES": "1000"})]
+
+
+def measure(name: str, script: Path, environment: dict, *, repeats: int, ticks: int = TICKS) -> AppFigure:
+    from conformance.apps import judge, launch
+    from conformance.tolerances import DEFAULT
+
+    best = None
+    for _ in range(repeats):
+        saved = {k: os.environ.get(k) for k in environment}
+        os.environ.update(environment)
+        try:
+            recording = launch.record(script, ticks=ticks)
+        finally:
+            for key, value in saved.items():
+                if value is None:
+                    os.environ.pop(key, None)
+                else:
+                    os.environ[key] = value
+        start = time.perf_counter()
+        judge(recording, tolerance=DEFAULT)
+        judged = time.perf_counter() - start
+        n = max(recording.ticks, 1)
+        figure = AppFigure(name, recording.ticks, (recording.seconds["record"] + judged) / n,
+                           recording.seconds["app"] / n, recording.seconds["record"] / n, judged / n)
+        if best is None or figure.ratio < best.ratio:
+            best = figure
+    return best
