@@ -14,6 +14,9 @@ Each command lives in its own module of :mod:`conformance.commands`:
 * ``regen [SCENE…] [--missing | --failing]``: make golden snapshots anew and say what changed;
 * ``bench``: sync, render and check costs as ratios to the floor measured in the same run;
 * ``documented``: pybullet's behaviour measured against its documentation, as a markdown table.
+
+Every command takes ``--scenes SOURCE`` (repeatable): a file or module of your own scenes, seen by the
+command and by every process it starts (:mod:`conformance.own_scenes`).
 """
 
 from __future__ import annotations
@@ -22,6 +25,7 @@ import argparse
 import importlib
 import sys
 
+from conformance import own_scenes
 from conformance.commands import MODULES
 from conformance.errors import ConformanceError
 
@@ -35,9 +39,14 @@ def _commands() -> dict:
 
 def _parser(commands: dict) -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="python -m conformance", description=__doc__.splitlines()[0])
+    common = argparse.ArgumentParser(add_help=False)
+    common.add_argument("--scenes", action="append", default=[], metavar="SOURCE",
+                        help="a .py file or module of your own scenes (SceneSpec objects); repeatable. "
+                        "Also $CONFORMANCE_SCENES and the conformance.scenes entry points")
     sub = parser.add_subparsers(dest="command", required=True)
     for name, module in commands.items():
-        module.add_arguments(sub.add_parser(name, help=module.HELP, description=module.__doc__.split("\n\n")[0]))
+        module.add_arguments(sub.add_parser(name, help=module.HELP, parents=[common],
+                                            description=module.__doc__.split("\n\n")[0]))
     return parser
 
 
@@ -49,6 +58,8 @@ def main(argv: list[str] | None = None) -> int:
     if extra and not getattr(command, "TAKES_PYTEST_ARGS", False):
         parser.error(f"unrecognized arguments: {' '.join(extra)}")
     try:
+        own_scenes.load_all(args.scenes)
+        own_scenes.export(args.scenes)  # the processes this command starts see the same scenes
         return command.run(args, extra)
     except ConformanceError as err:
         print(f"error: {err}", file=sys.stderr)

@@ -47,7 +47,7 @@ class Pictures:
     """What the image checks need from the session: where goldens are, which tolerance set, where
     to put pictures, whether to regenerate."""
 
-    golden_dir: Path
+    golden_dir: Path | None  # None: each scene's own (conformance.own_scenes.golden_dir)
     tolerance: str  # one of conformance.validation.IMAGE_TOLERANCE_CHOICES
     results: Path
     keep_passing: bool
@@ -55,6 +55,13 @@ class Pictures:
     _renderer: dict[str, str] | None = field(default=None, repr=False)
 
     # -- the checks' side ---------------------------------------------------------------------
+    def golden_dir_for(self, scene: str) -> Path:
+        """Where ``scene``'s goldens are read and regenerated: the directory given, else the scene's own
+        (the kit's for its scenes, ``golden/<backend>/`` beside your file for yours)."""
+        from conformance import own_scenes
+
+        return self.golden_dir if self.golden_dir is not None else own_scenes.golden_dir(scene)
+
     @property
     def renderer(self) -> dict[str, str]:
         if self._renderer is None:
@@ -81,7 +88,8 @@ class Pictures:
 
     # -- the session's side -------------------------------------------------------------------
     def describe(self) -> str:
-        where = "the kit's own" if self.golden_dir == _default_golden_dir() else str(self.golden_dir)
+        where = ("each scene's own (the kit's; yours in golden/ beside your scene file)" if self.golden_dir is None
+                 else str(self.golden_dir))
         tolerance = ("auto (same-renderer for goldens this machine's renderer made, else other-renderer)"
                      if self.tolerance == "auto" else self.tolerance)
         return (f"goldens: {where}; image tolerance {tolerance}; results in {self.results}"
@@ -128,12 +136,6 @@ class Pictures:
             terminalreporter.write_line(f"conformance: image checks report: {path}")
 
 
-def _default_golden_dir() -> Path:
-    from conformance.rendering import golden
-
-    return golden.default_dir()
-
-
 def from_config(config) -> Pictures:
     """The session's :class:`Pictures`, read and validated once (with every other option of the plugin)."""
     cached = config.stash.get(_KEY, None)
@@ -146,7 +148,7 @@ def from_config(config) -> Pictures:
         options = validation.plugin_options(config)
     except BadArgument as err:
         raise pytest.UsageError(str(err)) from None
-    golden_dir = options.golden_dir.resolve() if options.golden_dir is not None else _default_golden_dir()
+    golden_dir = options.golden_dir.resolve() if options.golden_dir is not None else None
     pictures = Pictures(golden_dir=golden_dir, tolerance=options.image_tolerance, results=options.results.resolve(),
                         keep_passing=options.keep_passing, regen=options.regen)
     config.stash[_KEY] = pictures

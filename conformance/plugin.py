@@ -10,7 +10,7 @@ Options live under one group, each mirrored by an ini setting:
 * ``--conformance-report PATH`` / ``conformance_report``: write every check's outcome, scene and
   worst measured error as JSON (what ``python -m conformance verdicts`` reads).
 * Pictures (:mod:`conformance.image_options` reads and validates them):
-  ``--conformance-golden-dir DIR`` / ``conformance_golden_dir`` (default: the kit's own goldens),
+  ``--conformance-golden-dir DIR`` / ``conformance_golden_dir`` (default: each scene's own goldens: the kit's, or golden/<backend>/ beside your scene file),
   ``--conformance-image-tolerance auto|same-renderer|other-renderer`` / ``conformance_image_tolerance``,
   ``--conformance-results DIR`` / ``conformance_results`` (failure pictures, records and the HTML report;
   default ``conformance-results``), ``--conformance-keep-passing`` / ``conformance_keep_passing`` (keep the
@@ -70,6 +70,11 @@ def pytest_addoption(parser: pytest.Parser) -> None:
     group.addoption("--conformance-app-ticks", dest="conformance_app_ticks", default=None, metavar="N",
                     help="ticks of each app's own run (default 120)")
     parser.addini("conformance_app_ticks", "default for --conformance-app-ticks", default=None)
+    group.addoption("--conformance-scenes", dest="conformance_scenes", action="append", default=None, metavar="SOURCE",
+                    help="a .py file or module of your own scenes (SceneSpec objects), checked beside the kit's; "
+                    "repeatable, added to the ini conformance_scenes and $CONFORMANCE_SCENES")
+    parser.addini("conformance_scenes", "your own scene sources (.py files relative to the ini file, or modules), "
+                  "one per line", type="linelist", default=[])
     from conformance import image_options
 
     image_options.add_options(group, parser)
@@ -154,8 +159,23 @@ def app_ticks(config: pytest.Config) -> int:
         raise pytest.UsageError(str(err)) from None
 
 
+def load_own_scenes(config: pytest.Config) -> None:
+    """Register the user's scenes (``--conformance-scenes``, ini ``conformance_scenes``, ``$CONFORMANCE_SCENES``,
+    entry points) before the checks are collected: they are parametrized over the registry at import."""
+    from conformance import own_scenes
+    from conformance.errors import BadArgument
+
+    try:
+        own_scenes.load_all(config.getini("conformance_scenes"),
+                            relative_to=config.inipath.parent if config.inipath else config.rootpath)
+        own_scenes.load_all(config.getoption("conformance_scenes") or (), environment=False)
+    except BadArgument as err:
+        raise pytest.UsageError(str(err)) from None
+
+
 def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line("markers", "scene(name): the reference scene a conformance check runs on")
+    load_own_scenes(config)
     config.addinivalue_line("markers", "sync: a check that runs the sync implementation under test (added automatically)")
     # pytest-xdist registers it itself; without xdist installed the kit's grouping of a scene's checks
     # would otherwise warn as an unknown mark in every run.

@@ -44,7 +44,10 @@ def each_scene(argname: str = "scene_name", origin: str | None = None, only: Seq
 
 def reproduce_command(scene: str, sync: str, frames: int, params: Mapping[str, Any], events: Sequence = ()) -> str:
     """The command line that replays a run frame by frame and prints every target's error."""
-    words = ["python", "-m", "conformance", "check", scene, "--sync", sync, "--frames", str(frames)]
+    from conformance import own_scenes
+
+    words = ["python", "-m", "conformance", "check", scene, *own_scenes.scene_arguments(scene), "--sync", sync,
+             "--frames", str(frames)]
     if params:
         words += ["--params", json.dumps(dict(params), sort_keys=True)]
     if events:

@@ -27,14 +27,18 @@ from conformance.pytest_helpers import each_scene
 
 
 def _reproduce(check: str, scene: str, sync: str) -> str:
-    return shlex.join(["pytest", "--pyargs", "conformance", "-k", f"{check} and {scene}", "--sync", sync])
+    from conformance import own_scenes
+
+    source = own_scenes.scene_arguments(scene)[1:]
+    return shlex.join(["pytest", "--pyargs", "conformance", "-k", f"{check} and {scene}", "--sync", sync,
+                       *(["--conformance-scenes", *source] if source else [])])
 
 
 def _goldens(pictures, scene):
     from conformance.rendering import snapshots
 
     try:
-        return {frame: snapshots.load(pictures.golden_dir, scene, frame)
+        return {frame: snapshots.load(pictures.golden_dir_for(scene.name), scene, frame)
                 for frame in scenes.get(scene.name).frames_with_goldens()}
     except GoldenError as err:
         pytest.fail(str(err), pytrace=False)
@@ -46,7 +50,7 @@ def test_golden_render(scene_name, kit, pictures, request):
     from conformance.rendering import snapshots
 
     if pictures.regen:
-        pictures.note_regenerated(request.node, snapshots.regenerate(scene_name, pictures.golden_dir))
+        pictures.note_regenerated(request.node, snapshots.regenerate(scene_name, pictures.golden_dir_for(scene_name)))
     failures = []
     with kit.run(scene_name) as run:
         goldens = _goldens(pictures, run.scene)

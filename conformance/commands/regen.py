@@ -14,27 +14,28 @@ def add_arguments(parser) -> None:
     which.add_argument("--missing", action="store_true", help="only goldens that are missing or unreadable")
     which.add_argument("--failing", action="store_true", help="only goldens that are missing, unreadable or fail "
                        "the render check with the reference sync")
-    parser.add_argument("--golden-dir", default=None, help="directory of goldens (default: the kit's own)")
+    parser.add_argument("--golden-dir", default=None, help="directory of goldens for every scene named (default: each scene's own: the kit's, or golden/<backend>/ beside your scene file)")
 
 
 def run(args, extra) -> int:
-    from conformance import scenes
+    from conformance import own_scenes, scenes
     from conformance.display import virtual_display
     from conformance.progress import progress
-    from conformance.rendering import golden, snapshots
+    from conformance.rendering import snapshots
 
     names = args.scene or scenes.names()
     for name in names:
         scenes.get(name)  # an unknown name fails before anything is rendered or written
-    directory = (validation.directory_to_write("--golden-dir", args.golden_dir) if args.golden_dir is not None
-                 else golden.default_dir())
+    given = validation.directory_to_write("--golden-dir", args.golden_dir) if args.golden_dir is not None else None
+    directories = {name: given if given is not None else own_scenes.golden_dir(name) for name in names}
     mode = "missing" if args.missing else "failing" if args.failing else "all"
     counts = {"new": 0, "changed": 0, "unchanged": 0}
     with virtual_display():
         for name in progress(names, total=len(names), what="goldens"):  # a bar on a terminal only
-            for change in snapshots.regenerate(name, directory, mode=mode):
+            for change in snapshots.regenerate(name, directories[name], mode=mode):
                 counts[change.status] += 1
                 print(change.describe())
-    print(f"goldens in {directory}: {counts['new']} new, {counts['changed']} changed, {counts['unchanged']} unchanged"
+    where = ", ".join(str(d) for d in dict.fromkeys(directories.values()))
+    print(f"goldens in {where}: {counts['new']} new, {counts['changed']} changed, {counts['unchanged']} unchanged"
           + ("" if mode == "all" else f" (only {mode} ones were made)"))
     return 0

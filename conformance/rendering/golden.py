@@ -22,6 +22,7 @@ from __future__ import annotations
 import importlib.metadata as md
 import io
 import json
+import os
 import shlex
 import zlib
 from dataclasses import dataclass
@@ -55,9 +56,16 @@ def paths(directory: Path | str, scene: str, frame: int) -> tuple[Path, Path]:
     return base.with_suffix(".png"), base.with_suffix(".json")
 
 
-def regen_command(scene: str) -> str:
-    """The command that (re)makes a scene's goldens (all its frames together: they share one run)."""
-    return shlex.join(["python", "-m", "conformance", "regen", scene])
+def regen_command(scene: str, directory: Path | str | None = None) -> str:
+    """The whole command that (re)makes a scene's goldens in ``directory`` (all its frames together:
+    they share one run): with ``--scenes`` for a user's scene and ``--golden-dir`` unless ``directory``
+    is where the scene's goldens live by default."""
+    from conformance import own_scenes
+
+    words = ["python", "-m", "conformance", "regen", scene, *own_scenes.scene_arguments(scene)]
+    if directory is not None and Path(directory).resolve() != own_scenes.golden_dir(scene).resolve():
+        words += ["--golden-dir", os.path.relpath(Path(directory).resolve())]
+    return shlex.join(words)
 
 
 def library_versions() -> dict[str, str]:
@@ -96,7 +104,7 @@ class Golden:
 def _unreadable(path: Path, scene: str, problem: str) -> GoldenUnreadable:
     return GoldenUnreadable(f"golden {str(path)!r} of scene {scene!r} {problem}; nothing was compared and nothing "
                             f"was written. If the scene changed on purpose, make its goldens anew: "
-                            f"{regen_command(scene)}")
+                            f"{regen_command(scene, path.parent.parent)}")  # <dir>/<scene>/frame-NNNN.png
 
 
 def _decode_png(path: Path, scene: str) -> np.ndarray:
@@ -123,9 +131,10 @@ def read(directory: Path | str, scene: str, frame: int, *, params: dict[str, Any
     """The golden of ``scene`` at ``frame``, validated against what the check is about to render."""
     png, manifest_path = paths(directory, scene, frame)
     if not png.exists() or not manifest_path.exists():
-        missing = " and ".join(str(p) for p in (png, manifest_path) if not p.exists())
-        raise GoldenMissing(f"no golden for scene {scene!r} at frame {frame}: {missing} does not exist. "
-                            f"Make it with: {regen_command(scene)} (then look at the picture before you commit it)")
+        missing = [str(p) for p in (png, manifest_path) if not p.exists()]
+        raise GoldenMissing(f"no golden for scene {scene!r} at frame {frame}: {' and '.join(missing)} "
+                            f"{'does' if len(missing) == 1 else 'do'} not exist. "
+                            f"Make it with: {regen_command(scene, directory)} (then look at the picture before you commit it)")
     try:
         manifest = json.loads(manifest_path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:

@@ -1,0 +1,132 @@
+"""Your own scenes are first class: the example of ``docs/own-scenes.md``, copied out verbatim, is seen
+by every command, gets its goldens beside it, is checked in the same run as the kit's scenes against
+their own goldens, and names itself in every message that tells you what to run.
+
+Everything that registers a scene runs in a child process: the registry of this process is the one
+the kit's own checks were collected from, and stays as it is.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shlex
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from conformance import backends, cli
+from conformance.display import child_environment, dies_with_this_process
+
+DOCS = Path(__file__).resolve().parent.parent / "docs" / "own-scenes.md"
+TESTS = Path(__file__).resolve().parent
+
+
+def _example() -> str:
+    text = DOCS.read_text(encoding="utf-8")
+    return re.search(r"Save as `my_scenes.py`.*?```python\n(.*?)```", text, re.S).group(1)
+
+
+def _run(where: Path, *words: str, env: dict | None = None) -> subprocess.CompletedProcess:
+    environment = child_environment()
+    environment.pop("CONFORMANCE_SCENES", None)
+    environment.update(env or {})
+    return subprocess.run([sys.executable, *words], cwd=where, capture_output=True, text=True, env=environment,
+                          preexec_fn=dies_with_this_process(waited_for=True))
+
+
+@pytest.fixture(scope="module")
+def project(tmp_path_factory) -> Path:
+    """A user's directory holding the documented ``my_scenes.py``, its goldens made by the documented command."""
+    where = tmp_path_factory.mktemp("project")
+    (where / "my_scenes.py").write_text(_example(), encoding="utf-8")
+    made = _run(where, "-m", "conformance", "regen", "tossed_die", "--scenes", "my_scenes.py")
+    assert made.returncode == 0, made.stdout + made.stderr
+    return where
+
+
+def test_every_command_lists_the_scene_after_the_kit_s(project):
+    listed = _run(project, "-m", "conformance", "scenes", "--scenes", "my_scenes.py")
+    assert listed.returncode == 0, listed.stderr
+    names = [line.split()[0] for line in listed.stdout.splitlines() if line.strip()]
+    assert names[-1] == "tossed_die" and "free_fall" in names
+    through_environment = _run(project, "-m", "conformance", "scenes", env={"CONFORMANCE_SCENES": "my_scenes.py"})
+    assert "tossed_die" in through_environment.stdout, through_environment.stderr
+    without = _run(project, "-m", "conformance", "scenes")
+    assert "tossed_die" not in without.stdout
+
+
+def test_regen_writes_the_goldens_beside_the_scene_file_not_into_the_kit(project):
+    from conformance.rendering import golden
+
+    made = sorted(p.name for p in (project / "golden" / backends.NAME / "tossed_die").iterdir())
+    assert made == ["frame-0000.json", "frame-0000.png", "frame-0060.json", "frame-0060.png",
+                    "frame-0120.json", "frame-0120.png"]
+    assert not (golden.default_dir() / "tossed_die").exists()
+
+
+def test_one_run_checks_the_kit_s_scenes_and_yours_each_against_its_own_goldens(project):
+    run = _run(project, "-m", "pytest", "--pyargs", "conformance", "-p", "no:cacheprovider", "-q",
+               "--conformance-scenes", "my_scenes.py", "-k", "tossed_die or (golden and free_fall)")
+    assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-2000:]
+    verdicts = {line.split()[1]: line.split()[0] for line in run.stdout.splitlines()
+                if line.startswith(("PASS ", "FAIL "))}
+    assert verdicts == {"free_fall": "PASS", "tossed_die": "PASS"}, run.stdout[-2000:]
+
+
+def test_a_missing_golden_names_the_whole_command_that_makes_it(project, tmp_path):
+    run = _run(project, "-m", "pytest", "--pyargs", "conformance", "-p", "no:cacheprovider", "-q",
+               "--conformance-scenes", "my_scenes.py", "-k", "test_golden_physics and tossed_die",
+               "--conformance-golden-dir", str(tmp_path))
+    assert run.returncode == 1
+    command = re.search(r"Make it with: (.*?) \(then look", run.stdout).group(1)
+    assert shlex.split(command) == ["python", "-m", "conformance", "regen", "tossed_die", "--scenes", "my_scenes.py",
+                                    "--golden-dir", os.path.relpath(tmp_path, project)]
+    # and the command, run as printed, makes what was missing
+    made = _run(project, *shlex.split(command)[1:])
+    assert made.returncode == 0, made.stderr
+    assert (tmp_path / "tossed_die" / "frame-0000.png").is_file()
+
+
+def test_a_failing_check_reproduces_as_printed_from_the_same_directory(project):
+    wrong = {"PYTHONPATH": str(TESTS)}
+    run = _run(project, "-m", "pytest", "--pyargs", "conformance", "-p", "no:cacheprovider", "-q",
+               "--conformance-scenes", "my_scenes.py", "--sync", "wrong_syncs:TransposedRotation",
+               "-k", "test_vertices_match_poses_every_frame and tossed_die", env=wrong)
+    assert run.returncode == 1, run.stdout[-2000:]
+    line = re.search(r"reproduce: (python -m conformance check tossed_die .*)", run.stdout).group(1)
+    assert "--scenes my_scenes.py" in line
+    replay = _run(project, *shlex.split(line)[1:], env=wrong)
+    assert replay.returncode == 1 and "FAIL tossed_die" in replay.stdout, replay.stdout + replay.stderr
+
+
+@pytest.mark.parametrize("content, message", [
+    (None, r"scene source 'absent.py': .*absent.py is not a file"),
+    ("x = 1\n", r"defines no SceneSpec; give it one at module level"),
+    ("raise RuntimeError('boom')\n", r"raised RuntimeError while being imported \(.*line 1\): boom"),
+    ("import no_such_package_here\n", r"imports 'no_such_package_here', which is not installed"),
+])
+def test_a_bad_source_is_one_sentence_and_exit_2(tmp_path, monkeypatch, capsys, content, message):
+    name = f"source_{abs(hash(content)) % 10**8}.py" if content is not None else "absent.py"
+    if content is not None:
+        (tmp_path / name).write_text(content, encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    status = cli.main(["scenes", "--scenes", name])
+    err = capsys.readouterr().err
+    assert status == 2 and re.search(message, err), err
+    assert len(err.strip().splitlines()) == 1
+
+
+def test_a_name_the_kit_uses_is_refused(tmp_path):
+    (tmp_path / "clash.py").write_text(_example().replace('name="tossed_die"', 'name="free_fall"'), encoding="utf-8")
+    run = _run(tmp_path, "-m", "conformance", "scenes", "--scenes", "clash.py")
+    assert run.returncode == 2
+    assert "defines scene 'free_fall', but a scene of that name is already registered (from the kit)" in run.stderr
+
+
+def test_pytest_refuses_a_bad_source_before_collecting(tmp_path):
+    run = _run(tmp_path, "-m", "pytest", "--pyargs", "conformance", "-p", "no:cacheprovider",
+               "--conformance-scenes", "absent.py")
+    assert run.returncode == 4 and "scene source 'absent.py'" in run.stderr
