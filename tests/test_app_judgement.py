@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from app_recordings import CORNERS, box_frame, draw, motion, recording, track
+from app_recordings import CORNERS, TICKS, box_frame, draw, motion, recording, track
 from conformance.apps import judge
 
 
@@ -89,6 +89,19 @@ def test_vertex_ranges_swapped_between_bodies_are_placed_wrong():
     assert "other-body" in verdicts["placed"].diagnoses
 
 
+def test_one_shared_actor_wrong_for_every_body_gets_one_line_per_body_and_nothing_else():
+    """Three bodies drawn by one actor, each with the conjugate rotation: a line per body, each naming that
+    body, with the diagnosis; no body is also reported undrawn (they are followed, badly)."""
+    moves = [motion(seed=s, offset=(1.5 * s, 0.0, 0.0)) for s in range(3)]
+    drawn = np.concatenate([draw(pos, Rotation.from_quat(orn).inv().as_quat()) for pos, orn in moves], axis=1)
+    verdicts = judge(recording([box_frame(b) for b in range(3)], moves, [track(drawn)]))
+    assert _failing(verdicts) == {"attached"}, {k: v.message() for k, v in verdicts.items() if not v.passed}
+    lines = [line for line in verdicts["attached"].lines if "not held" in line]
+    assert [line.split(": not held")[0].split("vertices ")[1] for line in lines] == ["0:8 of 24", "8:16 of 24", "16:24 of 24"]
+    assert [f"body {b} base" in line for b, line in enumerate(lines)] == [True] * 3
+    assert verdicts["attached"].diagnoses == ["conjugate"] * 3
+
+
 def test_normals_that_do_not_turn_fail_the_normals_check():
     pos, orn = motion()
     normals = CORNERS / np.linalg.norm(CORNERS, axis=1, keepdims=True)
@@ -112,3 +125,38 @@ def test_an_app_that_raised_fails_runs():
     rec = recording([box_frame()], [(pos, orn)], [track(draw(pos, orn))])
     rec.error = "the app raised at tick 3: ValueError: boom"
     assert _failing(judge(rec)) == {"runs"}
+
+
+def _with_writes(change_position, change_velocity=0.0, writer="resetBasePositionAndOrientation"):
+    """The right drawing, with the app writing to pyBullet after every tick's last step: each frame's pose
+    and velocity just before the write, then at the end of the tick changed by the given amounts."""
+    positions, orientations = motion()
+    made = recording([box_frame()], [(positions, orientations)], [track(draw(positions, orientations))])
+    velocities = np.zeros((len(positions), 1, 6))
+    before = np.concatenate([positions[:, None], orientations[:, None], velocities], axis=-1)
+    after = before.copy()
+    after[..., :3] += change_position
+    after[..., 7] += change_velocity
+    made.writes = np.concatenate([before, after], axis=-1)
+    made.writes[0] = np.nan  # the takeover: no tick has run
+    made.writers = [[]] + [[writer]] * TICKS
+    return made
+
+
+def test_a_write_that_changes_nothing_leaves_physics_untouched():
+    assert judge(_with_writes(0.0))["untouched"].passed
+
+
+@pytest.mark.parametrize("position, velocity, writer, diagnosis", [
+    # the float32-rounded pose written back (which also stops the body: pybullet 3.2.7)
+    (float(np.float32(2.0001)) - 2.0001, -0.5, "resetBasePositionAndOrientation", "written-back"),
+    (0.0, -0.5, "resetBasePositionAndOrientation", "written-back"),  # the pose as read, written back
+    (0.05, 0.0, "resetBasePositionAndOrientation", None),            # moved after stepping: not a rounding
+    (0.0, 0.5, "resetBaseVelocity", None),                           # only the velocity written
+])
+def test_a_write_after_the_last_step_fails_untouched(position, velocity, writer, diagnosis):
+    verdict = judge(_with_writes(position, velocity, writer))["untouched"]
+    assert not verdict.passed
+    assert "after the last p.stepSimulation() of tick 1" in verdict.message()
+    assert writer in verdict.message()
+    assert verdict.diagnoses == ([diagnosis] if diagnosis else []), verdict.message()

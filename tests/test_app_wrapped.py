@@ -55,6 +55,7 @@ def test_right_syncs_wrapped_as_apps_pass(wrapped, scene, sync):
     ("pendulum", "wrong_syncs:TransposedRotation", "attached", "conjugate"),
     ("weighted", "wrong_syncs:IgnoresBaseInertialFrame", "placed", "com-frame"),
     ("crossing", "wrong_syncs:SkipsLastTarget", "drawn", None),
+    ("weighted", "wrong_syncs:WritesPoseBack", "untouched", "written-back"),
 ])
 def test_wrong_syncs_wrapped_as_apps_fail_with_their_diagnosis(wrapped, scene, sync, check, diagnosis):
     result = wrapped(scene, sync)

@@ -21,7 +21,7 @@ import pybullet
 from conformance import poses, truth
 from conformance.client import BoundClient
 
-__all__ = ["Frame", "frames_of", "read_poses"]
+__all__ = ["Frame", "frames_of", "read_poses", "read_velocities"]
 
 #: pybullet's shape type codes, by name, for the records
 SHAPE_KINDS = {pybullet.GEOM_BOX: "box", pybullet.GEOM_SPHERE: "sphere", pybullet.GEOM_CYLINDER: "cylinder",
@@ -96,3 +96,18 @@ def read_poses(frames: list[Frame]) -> tuple[np.ndarray, np.ndarray]:
         pos, orn = truth.link_frames(BoundClient(client), [(frames[i].body, frames[i].link) for i in rows])
         positions[rows], orientations[rows] = pos, orn
     return positions, orientations
+
+
+def read_velocities(frames: list[Frame]) -> np.ndarray:
+    """Linear and angular velocities ``(F, 6)`` of ``frames``' centres of mass, now (read only when the kit
+    has to tell whether the app changed them: it costs one call per frame)."""
+    velocities = np.empty((len(frames), 6))
+    for i, frame in enumerate(frames):
+        if frame.link == -1:
+            linear, angular = pybullet.getBaseVelocity(frame.body, physicsClientId=frame.client)
+        else:
+            state = pybullet.getLinkState(frame.body, frame.link, computeLinkVelocity=1,
+                                          physicsClientId=frame.client)
+            linear, angular = state[6], state[7]
+        velocities[i, :3], velocities[i, 3:] = linear, angular
+    return velocities

@@ -6,6 +6,9 @@ The kit patches three things before the app's script runs, and nothing in the sc
   that ends with ``p.disconnect()`` takes its bodies away);
 * ``pybullet.stepSimulation`` to count the steps of each tick and to read every frame just before
   each step (so that a drawing one step behind is recognised as such);
+* pyBullet's state writers (``resetBasePositionAndOrientation``, ``resetBaseVelocity``, ``resetJointState``…)
+  to notice the app writing to the simulation after a tick's last step — where the sync runs — and to
+  read every frame just before that first write, so the judgement can tell what it changed;
 * FURY's window loop (:mod:`conformance.apps.takeover_vtk`, :mod:`conformance.apps.takeover_pygfx`):
   the call that would wait for a person (``showm.start()``, ``window.show``, ``window.record``…)
   drives the app's own per-frame callbacks ``ticks`` times instead, recording after each tick.
@@ -29,6 +32,11 @@ from conformance.apps.recording import ActorTrack, Recording
 from conformance.errors import ConformanceError
 
 __all__ = ["AppLoopNotFound", "Driver"]
+
+
+#: pyBullet's calls that change a body's pose or velocity (pybullet Quickstart, "Base, Joints, Links")
+STATE_WRITERS = ("resetBasePositionAndOrientation", "resetBaseVelocity", "resetJointState",
+                 "resetJointStateMultiDof", "resetJointStatesMultiDof")
 
 
 class AppLoopNotFound(ConformanceError):
@@ -116,6 +124,9 @@ class Driver:
         self._steps = 0
         self._tick = 0
         self._reading = 0.0  # seconds of the kit's reads inside the app's ticks (before each step)
+        self._stepped = False  # this tick has called stepSimulation
+        self._written = None   # (positions, orientations, velocities) just before the first write since the last step
+        self._writers: set[str] = set()
 
     # -- what the patches call ------------------------------------------------------------------
     def offer(self, source) -> None:
@@ -142,7 +153,20 @@ class Driver:
             self.error = (f"the app raised at tick {self._tick}: {type(exc).__name__}: {exc}\n"
                           + "".join(traceback.format_exception(exc)[-6:]))
 
+    def before_write(self, name: str) -> None:
+        """The app is about to write to pyBullet's state: after this tick's last step that is the sync's part
+        of the tick, which should only read. The state before the first such write is kept to compare."""
+        if self._frames and self._stepped:
+            if self._written is None:
+                start = time.perf_counter()
+                pos, orn = bodies.read_poses(self._frames)
+                self._written = (pos, orn, bodies.read_velocities(self._frames))
+                self._reading += time.perf_counter() - start
+            self._writers.add(name)
+
     def before_step(self) -> None:
+        self._stepped, self._written = True, None
+        self._writers = set()
         if self._frames:
             start = time.perf_counter()
             self._before = bodies.read_poses(self._frames)
@@ -180,10 +204,18 @@ class Driver:
         names = _labels(actors)
         tracks = [_Track(a, names.get(id(a)) or f"actor #{i}", self._backend) for i, a in enumerate(actors)]
         end_pos, end_orn, before_pos, before_orn, steps = [], [], [], [], []
+        nowhere = np.full((len(self._frames), 26), np.nan)
+        writes, writers = [], []
 
         def snapshot():
             pos, orn = bodies.read_poses(self._frames)
             end_pos.append(pos), end_orn.append(orn)
+            if self._written is None:
+                writes.append(nowhere)
+            else:  # [before the write | at the end of the tick]: position, quaternion, velocities
+                writes.append(np.concatenate([np.hstack(self._written), np.hstack([pos, orn, bodies.read_velocities(self._frames)])],
+                                             axis=1))
+            writers.append(sorted(self._writers))
             before = self._before if self._before is not None else (pos, orn)
             before_pos.append(before[0]), before_orn.append(before[1])
             for track in tracks:
@@ -198,6 +230,7 @@ class Driver:
         try:
             for tick in range(1, self.ticks + 1):
                 self._tick = tick
+                self._stepped, self._written, self._writers = False, None, set()  # the kit's own events are not the app's
                 perturb.apply(self.events, tick, clients[0], self._frames)
                 self._steps = 0
                 self._before = None
@@ -223,6 +256,7 @@ class Driver:
             before_positions=np.array(before_pos), before_orientations=np.array(before_orn),
             steps=np.array(steps, dtype=np.int64), loop=f"{source.describe()} (handed over at {self.entry or 'the end of the script'})",
             ended=ended, events=[perturb.as_dict(e) for e in self.events], notes=notes,
+            writes=np.array(writes), writers=writers,
             seconds={"app": in_ticks - self._reading, "record": in_snapshots + self._reading})
 
 
@@ -260,8 +294,19 @@ class _Track:
 
 
 def install_pybullet(driver: Driver) -> None:
-    """Wrap ``pybullet.connect``, ``disconnect`` and ``stepSimulation`` for ``driver`` (in the app's process)."""
+    """Wrap ``pybullet.connect``, ``disconnect``, ``stepSimulation`` and the state writers for ``driver``
+    (in the app's process)."""
     connect, disconnect, step = pybullet.connect, pybullet.disconnect, pybullet.stepSimulation
+
+    def writer(name, write):
+        def write_(*args, **kwargs):
+            driver.before_write(name)
+            return write(*args, **kwargs)
+        return write_
+
+    for name in STATE_WRITERS:
+        if hasattr(pybullet, name):
+            setattr(pybullet, name, writer(name, getattr(pybullet, name)))
 
     def connect_(*args, **kwargs):
         client = connect(*args, **kwargs)

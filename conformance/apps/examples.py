@@ -18,10 +18,11 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 from conformance.errors import ConformanceError
+from conformance.apps.judge import CHECKS
 
 __all__ = ["Expectation", "Outcome", "expectation", "judge_example", "table"]
 
-_CHECKS = ("runs", "attached", "drawn", "placed", "normals", "announced", "perturbed")
+_CHECKS = (*CHECKS, "perturbed")
 
 
 @dataclass(frozen=True)

@@ -8,7 +8,9 @@ Checks (the names are the pytest ids and the ``app`` command's lines):
 * ``drawn``: every frame pyBullet moves, that has a collision shape, is followed by some vertices;
 * ``placed``: a drawing whose shape is its frame's collision shape sits on it (:mod:`conformance.apps.placement`);
 * ``normals``: stored vertex normals turn with the frame that holds their vertices;
-* ``announced``: every change of an actor's vertex data was announced to the renderer at the tick it was made.
+* ``announced``: every change of an actor's vertex data was announced to the renderer at the tick it was made;
+* ``untouched``: after a tick's last ``stepSimulation`` — where the sync runs — the app leaves every body's pose
+  and velocity as pyBullet computed them (a sync only reads the simulation; the guide's recipes only read).
 
 Everything is computed from the :class:`~conformance.apps.recording.Recording` alone.
 """
@@ -27,7 +29,11 @@ from conformance.tolerances import DEFAULT, Tolerance
 
 __all__ = ["CHECKS", "DIAGNOSES", "Verdict", "judge"]
 
-CHECKS = ("runs", "attached", "drawn", "placed", "normals", "announced")
+CHECKS = ("runs", "attached", "drawn", "placed", "normals", "announced", "untouched")
+
+#: A write that changes a pose or velocity by no more than this is no change (resetting a body to the
+#: pose just read may round its last bit).
+UNTOUCHED_ATOL = 1e-12
 
 #: diagnosis id → what it means, for the docs and every failure line
 DIAGNOSES = {name: text for name, (text, _) in attach_mod.VARIANTS.items()} | {
@@ -39,6 +45,9 @@ DIAGNOSES = {name: text for name, (text, _) in attach_mod.VARIANTS.items()} | {
     "stale-normals": "the vertices turn but the stored normals do not: turn normals with the same rotation",
     "unannounced": "vertex data changed without telling the renderer, which keeps drawing the old data: call "
                    "utils.update_actor (FURY 0.12) or positions.update_range/update_full (FURY 2)",
+    "written-back": "the pose that was drawn (as read, or rounded to float32) is written back into pyBullet "
+                    "(\"so physics and graphics agree\"): resetBasePositionAndOrientation also sets the body's "
+                    "velocity to zero (pybullet 3.2.7), so the simulation is changed; a sync only reads",
 }
 
 
@@ -99,10 +108,9 @@ class _Judgement:
             if tied:
                 verdict.notes.append(f"{track.label}: {tied} vertices are held equally by two frames that never moved "
                                      "apart in this run (undecidable; the kit's perturbed runs move bodies apart)")
-            for start, stop in _runs(loose, np.zeros(len(loose), dtype=int)):
+            for start, stop, frame, diagnosis in self._loose_pieces(track, a, loose):
                 verdict.passed = False
                 rows = np.arange(start, stop)
-                frame, diagnosis = self._followed(track.vertices[1:, rows], a.frame[rows], a.reference[rows])
                 error, allowance = self._errors(track.vertices[1:, rows], frame)
                 bad_ticks = np.flatnonzero(np.any(error > allowance[:, None], axis=0))
                 first = int(bad_ticks[0]) if len(bad_ticks) else 0
@@ -118,6 +126,53 @@ class _Judgement:
                     verdict.diagnoses.append(diagnosis)
         verdict.worst = worst
         return verdict
+
+    def _loose_pieces(self, track, a, loose):
+        """``(start, stop, frame, diagnosis)`` of the actor's loose vertices, one per body or link they were
+        meant to follow (one shared actor draws many): each vertex goes to the nearby frame that holds it
+        under a known mistake (or, when none does, that it follows best), and consecutive vertices with the
+        same frame and mistake make one piece."""
+        pieces = []
+        for start, stop in _runs(loose, np.zeros(len(loose), dtype=int)):
+            rows = np.arange(start, stop)
+            frames, mistakes = self._owners(track.vertices[1:, rows], a.frame[rows], a.allowance[rows])
+            for s, e in _runs(np.ones(len(rows), dtype=bool), frames * (len(attach_mod.VARIANTS) + 1) + mistakes):
+                piece = rows[s:e]
+                if mistakes[s]:
+                    frame, diagnosis = int(frames[s]), list(attach_mod.VARIANTS)[mistakes[s] - 1]
+                else:
+                    frame, diagnosis = self._followed(track.vertices[1:, piece], a.frame[piece], a.reference[piece])
+                if pieces and pieces[-1][1] == piece[0] and pieces[-1][2:] == (frame, diagnosis):
+                    pieces[-1] = (pieces[-1][0], int(piece[-1]) + 1, frame, diagnosis)
+                else:
+                    pieces.append((int(piece[0]), int(piece[-1]) + 1, frame, diagnosis))
+        return pieces
+
+    def _owners(self, vertices, best, allowance) -> tuple[np.ndarray, np.ndarray]:
+        """Per loose vertex ``(T, m, 3)``: the frame index it belongs to and the mistake (1-based index into
+        the catalogue, 0 none) under which that frame holds it. Candidates are the frames near it at tick 1
+        (within twice their shape's radius) and the frame that came nearest to holding it."""
+        m = vertices.shape[1]
+        frames = np.where(best >= 0, best, 0).astype(int)
+        mistakes = np.zeros(m, dtype=int)
+        if not self.r.frames:
+            return frames, mistakes
+        radius = np.array([bounding_radius(f.shapes) if f.shapes else 0.0 for f in self.r.frames])
+        distance = np.linalg.norm(vertices[0][:, None, :] - self.pos[0][None, :, :], axis=-1)  # (m, F)
+        near = distance <= 2 * radius[None, :] + 1e-9
+        near[np.arange(m)[best >= 0], best[best >= 0]] = True
+        score = np.full(m, np.inf)
+        before_pos, before_orn = self.r.before_positions[1:], self.r.before_orientations[1:]
+        for f in np.flatnonzero(near.any(axis=0)):
+            rows = np.flatnonzero(near[:, f])
+            idx = np.full(len(rows), f)
+            for k, (_, make) in enumerate(attach_mod.VARIANTS.values(), start=1):
+                positions, rotations = make(self.pos[:, idx], self.orn[:, idx], before_pos[:, idx], before_orn[:, idx])
+                local = attach_mod.local_coordinates(vertices[:, rows], np.asarray(positions), np.asarray(rotations))
+                error = np.linalg.norm(local - np.median(local, axis=0), axis=-1).max(axis=0) / allowance[rows]
+                better = (error <= 1.0) & (error < score[rows])
+                frames[rows[better]], mistakes[rows[better]], score[rows[better]] = f, k, error[better]
+        return frames, mistakes
 
     def _followed(self, vertices, best, reference) -> tuple[int, str]:
         """The frame a run of loose vertices follows, and the mistake that explains it if one does: of
@@ -273,6 +328,45 @@ class _Judgement:
                                      f"({len(silent)} ticks in all) without being announced to the renderer")
                 verdict.lines.append(f"    diagnosis: {DIAGNOSES['unannounced']}")
                 verdict.diagnoses.append("unannounced")
+        return verdict
+
+
+    def untouched(self) -> Verdict:
+        verdict = Verdict("untouched", True)
+        writes = self.r.writes
+        if writes is None or not np.isfinite(writes).any():
+            return verdict
+        before, after = writes[..., :13], writes[..., 13:]
+        moved = np.linalg.norm(after[..., :3] - before[..., :3], axis=-1)
+        turned = np.full(moved.shape, np.nan)
+        known = np.isfinite(before[..., 3:7]).all(axis=-1) & np.isfinite(after[..., 3:7]).all(axis=-1)
+        turned[known] = (Rotation.from_quat(after[..., 3:7][known]) * Rotation.from_quat(before[..., 3:7][known]).inv()).magnitude()
+        sped = np.linalg.norm(after[..., 7:] - before[..., 7:], axis=-1)
+        change = np.nan_to_num(np.maximum(np.maximum(moved, turned), sped), nan=0.0)
+        changed = change > UNTOUCHED_ATOL
+        if not changed.any():
+            return verdict
+        verdict.passed = False
+        ticks = np.flatnonzero(changed.any(axis=1))
+        frames = np.flatnonzero(changed.any(axis=0))
+        tick, frame = np.unravel_index(int(np.argmax(np.where(changed, change, -1))), change.shape)
+        first = int(ticks[0])
+        calls = ", ".join(sorted({name for t in ticks for name in (self.r.writers[t] if t < len(self.r.writers) else [])}))
+        verdict.lines.append(
+            f"after the last p.stepSimulation() of tick {first}, the app's own code changed what pyBullet computed "
+            f"({calls or 'a state writer'}): {len(frames)} frame(s) on {len(ticks)} of {self.r.ticks} ticks; the most, "
+            f"{self.frame_label(int(frame))} at tick {tick}: moved {moved[tick, frame]:.3g} m, turned {turned[tick, frame]:.3g} rad, "
+            f"velocity changed by {np.nan_to_num(sped[tick, frame]):.3g} (m/s, rad/s); allowed {UNTOUCHED_ATOL:g} (a sync only reads the "
+            "simulation; move bodies on purpose before stepping)")
+        # Written back: every change no bigger than float32 rounding (with a float32 normalisation) of the value
+        eps = 4 * np.finfo(np.float32).eps
+        near = np.abs(after[..., :7] - before[..., :7]) <= eps * np.maximum(np.abs(before[..., :7]), 1.0)
+        pose_writers = {"resetBasePositionAndOrientation", "resetJointState", "resetJointStateMultiDof",
+                        "resetJointStatesMultiDof"}
+        if pose_writers & set(calls.split(", ")) and np.all(near[changed]):
+            verdict.lines.append(f"    diagnosis: {DIAGNOSES['written-back']}")
+            verdict.diagnoses.append("written-back")
+        verdict.worst = float(change.max())
         return verdict
 
 

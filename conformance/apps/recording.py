@@ -59,6 +59,11 @@ class Recording:
     #: seconds spent in the app's own ticks (its callbacks: steps, sync, render) and in the kit's reads
     #: and records around them, over the whole run (the cost benchmark's figures)
     seconds: dict = field(default_factory=dict)
+    #: (T+1, F, 26) where the app wrote to pyBullet after a tick's last step: each frame's position,
+    #: quaternion and velocities just before the first write, then the same at the end of the tick
+    #: (NaN in ticks without such a write); None in recordings made without it
+    writes: np.ndarray | None = None
+    writers: list = field(default_factory=list)  # per tick, the names of the writing calls
 
     @property
     def ticks(self) -> int:
@@ -70,6 +75,8 @@ def save(recording: Recording, path) -> None:
     arrays = {"positions": recording.positions, "orientations": recording.orientations,
               "before_positions": recording.before_positions, "before_orientations": recording.before_orientations,
               "steps": recording.steps}
+    if recording.writes is not None:
+        arrays["writes"] = recording.writes
     actors = []
     for i, track in enumerate(recording.actors):
         arrays[f"a{i}_vertices"] = track.vertices
@@ -81,7 +88,7 @@ def save(recording: Recording, path) -> None:
     meta = {"script": recording.script, "backend": recording.backend, "actors": actors,
             "frames": [f.as_dict() for f in recording.frames], "loop": recording.loop, "ended": recording.ended,
             "events": recording.events, "notes": recording.notes,
-            "error": recording.error, "seconds": recording.seconds}
+            "error": recording.error, "seconds": recording.seconds, "writers": recording.writers}
     arrays["meta"] = np.frombuffer(json.dumps(meta).encode("utf-8"), dtype=np.uint8)
     buffer = io.BytesIO()
     np.savez(buffer, **arrays)
@@ -105,4 +112,5 @@ def load(path) -> Recording:
                          data["positions"], data["orientations"], data["before_positions"],
                          data["before_orientations"], data["steps"], meta["loop"], meta["ended"],
                          meta["events"], meta["notes"], meta.get("error", ""),
-                         meta.get("seconds", {}))
+                         meta.get("seconds", {}), data["writes"] if "writes" in data else None,
+                         meta.get("writers", []))
