@@ -89,6 +89,26 @@ def test_vertex_ranges_swapped_between_bodies_are_placed_wrong():
     assert "other-body" in verdicts["placed"].diagnoses
 
 
+def test_a_vertex_range_paired_with_the_wrong_body_far_away_is_placed_wrong():
+    """Body 1's box drawn with body 0's pose, where it was built (a range counted wrong): rigid in body 0's
+    frame, so attached holds it; the vertices body 0 holds reach 1 m past its shape, so placed does not."""
+    a, b = motion(seed=1), motion(seed=2, offset=(1.0, 0.0, 0.0))
+    offset = Rotation.from_quat(a[1][0]).inv().apply(b[0][0] - a[0][0])
+    drawn = np.concatenate([draw(*a), draw(*a, CORNERS + offset)], axis=1)
+    verdicts = judge(recording([box_frame(0), box_frame(1)], [a, b], [track(drawn)]))
+    assert "placed" in _failing(verdicts) and "attached" not in _failing(verdicts)
+    assert verdicts["placed"].diagnoses == ["other-body"], verdicts["placed"].message()
+    assert "reaches 1" in verdicts["placed"].message()
+
+
+def test_a_decoration_near_its_body_is_not_judged_and_passes():
+    """A box drawn half again as large as its collision box, around it: another shape, not judged."""
+    pos, orn = motion()
+    verdicts = judge(recording([box_frame()], [(pos, orn)], [track(draw(pos, orn, CORNERS * 1.5))]))
+    assert _failing(verdicts) == set()
+    assert any("not judged" in note for note in verdicts["placed"].notes)
+
+
 def test_one_shared_actor_wrong_for_every_body_gets_one_line_per_body_and_nothing_else():
     """Three bodies drawn by one actor, each with the conjugate rotation: a line per body, each naming that
     body, with the diagnosis; no body is also reported undrawn (they are followed, badly)."""

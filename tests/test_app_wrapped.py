@@ -56,6 +56,7 @@ def test_right_syncs_wrapped_as_apps_pass(wrapped, scene, sync):
     ("weighted", "wrong_syncs:IgnoresBaseInertialFrame", "placed", "com-frame"),
     ("crossing", "wrong_syncs:SkipsLastTarget", "drawn", None),
     ("weighted", "wrong_syncs:WritesPoseBack", "untouched", "written-back"),
+    ("wrecking_ball", "wrong_syncs:WrongVertexRange", "placed", "other-body"),
 ])
 def test_wrong_syncs_wrapped_as_apps_fail_with_their_diagnosis(wrapped, scene, sync, check, diagnosis):
     result = wrapped(scene, sync)

@@ -11,7 +11,10 @@ the collision shape, and its centre must then be the shape's centre. "The same b
 tessellation reaches 98.1 % of the radius); so does "the centre".
 
 When the extents differ (an app that draws a decoration, or a visual shape other than its collision
-shape) the kit says the placement was not judged, and why: it never guesses an offset it cannot know.
+shape) the kit says the placement was not judged, and why: it never guesses an offset it cannot know —
+unless some of those vertices lie far beyond the shape (more than twice its radius, and 1 cm): those are
+drawn with this frame's pose at another body's place, the mistake of a vertex range paired with the wrong
+link (FURY's wrecking-ball example), which attachment alone cannot see.
 """
 
 from __future__ import annotations
@@ -24,6 +27,12 @@ from scipy.spatial.transform import Rotation
 from conformance.tolerances import DEFAULT, Tolerance
 
 __all__ = ["Placement", "bounding_radius", "place", "shape_box"]
+
+#: A drawing of another size than the collision shape is not judged, unless a vertex it holds lies further
+#: from the shape's centre than REACH times the shape's radius plus REACH_MARGIN: no decoration of a body
+#: reaches that far, while a vertex range paired with the wrong link of a chain does (a link's length away).
+REACH = 2.0
+REACH_MARGIN = 0.01  # metres
 
 
 def shape_box(shapes) -> tuple[np.ndarray, np.ndarray] | None:
@@ -93,6 +102,12 @@ def place(reference: np.ndarray, shapes, inertial_position, *, tolerance: Tolera
     if np.all(np.abs(np.sort(drawn_half) - np.sort(half)) <= allowance):
         return Placement(True, False, f"drawn turned in its frame: half extents {_v(drawn_half)} in the link frame's "
                          f"axes where the collision shape's are {_v(half)}", diagnosis="turned-shape")
+    reach = float(np.max(np.linalg.norm(reference - centre, axis=1)))
+    limit = REACH * float(np.linalg.norm(half)) + REACH_MARGIN
+    if reach > limit:
+        return Placement(True, False, f"reaches {reach:.3g} m from its collision shape's centre, more than {REACH:g} times "
+                         f"the shape's radius ({float(np.linalg.norm(half)):.3g} m) and {REACH_MARGIN:g} m: drawn with this "
+                         "frame's pose but elsewhere", drawn_centre - centre, "other-body")
     return Placement(False, True, f"not judged: the drawn shape (half extents {_v(drawn_half)}) is not the collision "
                      f"shape ({shapes[0][0]}, half extents {_v(half)})")
 

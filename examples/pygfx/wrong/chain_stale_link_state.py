@@ -16,8 +16,8 @@ Physics as in the kit's ``chain`` scene: a 0.1 kg base pinned at (0, 0, 2) by a 
 whose pivot follows (0.9 sin(2 pi 0.6 t), 0, 2) with max force 500 N; 20 links of 0.5 kg, 0.1 m
 apart; joint friction as a velocity motor (kp 0, kd 1, force 0.0005); gravity -10; 131 steps.
 
-MISTAKE: reads p.getLinkState(rope, j)[4:6] without computeForwardKinematics=1, as the guide's sync_joints does, so the links are drawn at a stale pose; on this chain, whose pin moves every step, that pose is not exactly the previous step's, so no diagnosis names it
-EXPECT: fail attached
+MISTAKE: reads p.getLinkState(rope, j)[4:6] without computeForwardKinematics=1, as the guide's sync_joints does, so each link is drawn where it was before the last step
+EXPECT: fail attached previous-step
 """
 
 import itertools
