@@ -101,6 +101,21 @@ def test_a_vertex_range_paired_with_the_wrong_body_far_away_is_placed_wrong():
     assert "reaches 1" in verdicts["placed"].message()
 
 
+@pytest.mark.parametrize("shared", [True, False])
+def test_bodies_that_move_together_hold_each_others_vertices_and_a_right_drawing_still_passes(shared):
+    """Two boxes 0.5 m apart, falling and turning as one (released side by side from rest): each holds the
+    other's vertices as well as its own. The vertices belong to the box they are drawn on, so a right
+    drawing passes, and its ties are noted as undecidable from this run."""
+    pos, orn = motion(seed=3)
+    gap = Rotation.from_quat(orn).apply([0.5, 0.0, 0.0])
+    moves = [(pos, orn), (pos + gap, orn)]
+    drawings = [draw(*m) for m in moves]
+    tracks = [track(np.concatenate(drawings, axis=1))] if shared else [track(d, label=f"box{i}") for i, d in enumerate(drawings)]
+    verdicts = judge(recording([box_frame(0), box_frame(1)], moves, tracks))
+    assert _failing(verdicts) == set(), {k: v.message() for k, v in verdicts.items() if not v.passed}
+    assert any("held equally" in note for note in verdicts["attached"].notes)
+
+
 def test_a_decoration_near_its_body_is_not_judged_and_passes():
     """A box drawn half again as large as its collision box, around it: another shape, not judged."""
     pos, orn = motion()

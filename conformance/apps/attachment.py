@@ -9,8 +9,9 @@ median over the ticks), a vertex may be off by the tolerance at a tick and by th
 reference: the allowance is twice the tolerance.
 
 What this cannot decide, and what decides it: two frames that never move relative to each other
-(a body at rest on a static one, a static body and the world) hold the same vertices equally; the
-kit then names the first and says so, and its own events (:mod:`conformance.apps.perturb`) move
+(a body at rest on a static one, a static body and the world, two bodies released side by side) hold
+the same vertices equally; the kit then gives each vertex to the frame whose collision shape it lies on
+(the world only when no body holds it) and says so, and its own events (:mod:`conformance.apps.perturb`) move
 dynamic bodies apart. What it cannot see: a drawing held rigidly by the *right* frame at the wrong
 place in it (drawn at the centre of mass, a vertex range following another body):
 :mod:`conformance.apps.placement` judges where in its frame a drawing sits.
@@ -22,6 +23,7 @@ holds but a variant does is diagnosed by it.
 from __future__ import annotations
 
 import functools
+import warnings
 
 from dataclasses import dataclass
 
@@ -96,15 +98,20 @@ def _probes(ticks: int, extra=()) -> np.ndarray:
 
 
 def attach(vertices: np.ndarray, positions: np.ndarray, rotations: np.ndarray, *, tolerance: Tolerance = DEFAULT,
-           event_ticks=()) -> Attachment:
+           event_ticks=(), centres: np.ndarray | None = None, radii: np.ndarray | None = None) -> Attachment:
     """Find the frame holding each vertex and its error at every tick.
 
     ``vertices`` ``(T, n, 3)`` are one actor's drawn vertices at the judged ticks; ``positions``
     ``(T, F, 3)`` and ``rotations`` ``(T, F, 3, 3)`` the link frames at the same ticks. Every vertex is
     tried in its :data:`FIRST` nearest frames and the world; one that none of them holds in its
-    :data:`NEAREST` nearest, then in every frame (so a range following a far-away body is still found)."""
+    :data:`NEAREST` nearest, then in every frame (so a range following a far-away body is still found).
+    ``centres`` ``(F, 3)`` and ``radii`` ``(F,)`` are the frames' collision shapes (centre in the frame,
+    bounding radius), to choose between frames that hold a vertex equally; by default the frame origins
+    and 1 m."""
     ticks, n, _ = vertices.shape
     frames = positions.shape[1]
+    centres = np.zeros((frames, 3)) if centres is None else np.asarray(centres, dtype=np.float64)
+    radii = np.ones(frames) if radii is None else np.maximum(np.asarray(radii, dtype=np.float64), 1e-6)
     pos, rot = _world(positions, rotations)
     probes = _probes(ticks, [t - 1 for t in event_ticks] + list(event_ticks))
     tree = cKDTree(positions[0]) if frames else None
@@ -124,7 +131,16 @@ def attach(vertices: np.ndarray, positions: np.ndarray, rotations: np.ndarray, *
     candidates = nearest(everyone, min(frames, FIRST))
     spreads = spreads_of(everyone, candidates)
     best = candidates[everyone, np.argmin(spreads, axis=1)] if n else np.zeros(0, dtype=int)
-    best_spread = spreads.min(axis=1) if n else np.zeros(0)
+    allowance = _allowance(vertices, pos, rot, best, tolerance)
+    # Frames that hold a vertex within the tolerance hold it equally (two bodies falling side by side from
+    # rest keep their relative pose): the one it is drawn on is the one whose shape it lies on (smallest
+    # distance from the shape's centre over the shape's radius), not the one whose spread happens to be
+    # smallest by rounding; the world only when no body holds it.
+    holding = spreads <= allowance[:, None]
+    closeness = np.where(holding, _shape_distance(vertices[0], pos[0], rot[0], candidates, centres, radii), np.inf)
+    choice = np.where(holding.any(axis=1), np.argmin(closeness, axis=1), np.argmin(spreads, axis=1)) if n else np.zeros(0, int)
+    best = candidates[everyone, choice] if n else np.zeros(0, dtype=int)
+    best_spread = spreads[everyone, choice] if n else np.zeros(0)
     allowance = _allowance(vertices, pos, rot, best, tolerance)
     for k in (NEAREST, frames):
         loose = np.flatnonzero(best_spread > allowance)
@@ -146,6 +162,16 @@ def attach(vertices: np.ndarray, positions: np.ndarray, rotations: np.ndarray, *
     return Attachment(frame=frame, error=error, allowance=allowance, reference=reference, tied=tied)
 
 
+def _shape_distance(vertices0, pos0, rot0, candidates, centres, radii) -> np.ndarray:
+    """``(n, k)``: each vertex's distance from each candidate frame's shape centre, over the shape's radius
+    (below 1 on the shape); the world (the last frame) is farther than any body."""
+    frames = pos0.shape[0] - 1
+    c = np.concatenate([centres, np.zeros((1, 3))])[candidates]
+    r = np.concatenate([radii, [1.0]])[candidates]
+    local = _transposed_times(rot0[candidates], vertices0[:, None, :] - pos0[candidates])
+    return np.where(candidates == frames, 1e30, np.linalg.norm(local - c, axis=-1) / r)
+
+
 def _allowance(vertices, pos, rot, best, tolerance: Tolerance) -> np.ndarray:
     """Twice the kit's tolerance for each vertex, from the extent of the vertices its frame holds in
     this actor and the frame's largest distance from the origin."""
@@ -163,7 +189,9 @@ def _allowance(vertices, pos, rot, best, tolerance: Tolerance) -> np.ndarray:
 def _vtk_euler(quaternions: np.ndarray) -> np.ndarray:
     """What ``SetOrientation(*degrees(getEulerFromQuaternion(q)))`` draws: pyBullet's roll, pitch, yaw
     (about fixed x, y, z) used by VTK as the angles of ``Rz·Rx·Ry`` (measured: intrinsic z, x, y)."""
-    roll, pitch, yaw = Rotation.from_quat(quaternions.reshape(-1, 4)).as_euler("xyz").T
+    with warnings.catch_warnings():  # at pitch ±90° scipy zeroes one angle, as getEulerFromQuaternion does
+        warnings.simplefilter("ignore", UserWarning)
+        roll, pitch, yaw = Rotation.from_quat(quaternions.reshape(-1, 4)).as_euler("xyz").T
     return Rotation.from_euler("ZXY", np.stack([yaw, roll, pitch], axis=1)).as_matrix().reshape(quaternions.shape[:-1] + (3, 3))
 
 

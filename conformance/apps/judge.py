@@ -23,7 +23,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from conformance.apps import attachment as attach_mod
-from conformance.apps.placement import bounding_radius, place
+from conformance.apps.placement import bounding_radius, bounding_sphere, place
 from conformance.apps.recording import Recording
 from conformance.tolerances import DEFAULT, Tolerance
 
@@ -75,8 +75,12 @@ class _Judgement:
         self.orn = recording.orientations[1:]
         self.rot = _rotations(self.orn) if self.orn.size else np.zeros(self.orn.shape[:-1] + (3, 3))
         self.event_ticks = sorted({int(e["frame"]) - 1 for e in recording.events})
+        spheres = [bounding_sphere(f.shapes) for f in recording.frames]
+        centres = np.array([c for c, _ in spheres]).reshape(-1, 3)
+        radii = np.array([r for _, r in spheres])
         self.attachments = [attach_mod.attach(a.vertices[1:], self.pos, self.rot, tolerance=tolerance,
-                                              event_ticks=self.event_ticks) for a in recording.actors] \
+                                              event_ticks=self.event_ticks, centres=centres, radii=radii)
+                            for a in recording.actors] \
             if recording.ticks else []
         self.followed_badly: set[int] = set()
         self._attached_done = False

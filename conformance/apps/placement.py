@@ -26,7 +26,7 @@ from scipy.spatial.transform import Rotation
 
 from conformance.tolerances import DEFAULT, Tolerance
 
-__all__ = ["Placement", "bounding_radius", "place", "shape_box"]
+__all__ = ["Placement", "bounding_radius", "bounding_sphere", "place", "shape_box"]
 
 #: A drawing of another size than the collision shape is not judged, unless a vertex it holds lies further
 #: from the shape's centre than REACH times the shape's radius plus REACH_MARGIN: no decoration of a body
@@ -63,6 +63,15 @@ def bounding_radius(shapes, default: float = 0.05) -> float:
         if box is not None:
             radii.append(float(np.linalg.norm(box[0]) + np.linalg.norm(box[1])))
     return max(radii, default=default)
+
+
+def bounding_sphere(shapes) -> tuple[np.ndarray, float]:
+    """Centre (in the link frame) and radius of a sphere around a frame's collision shape: its one box,
+    sphere or cylinder's, else one around the frame's origin."""
+    box = shape_box(shapes)
+    if box is None:
+        return np.zeros(3), bounding_radius(shapes)
+    return box[0], float(np.linalg.norm(box[1]))
 
 
 @dataclass
