@@ -294,6 +294,8 @@ def pytest_runtest_makereport(item: pytest.Item, call):
     from conformance import survey
 
     survey.settle(item, report)  # survey mode: a check that noted failures fails now, naming every kind
+    if report.when == "call" and report.failed and _is_property(item):
+        _say_how_shrunk(report)
     if report.when == "call" or report.outcome != "passed":
         marker = item.get_closest_marker("scene")
         message = ""
@@ -313,6 +315,21 @@ def pytest_runtest_makereport(item: pytest.Item, call):
             "message": message.strip().splitlines()[0][:4000] if message.strip() else "",
         }))
     return report
+
+
+def _is_property(item: pytest.Item) -> bool:
+    return bool(getattr(getattr(item, "obj", None), "is_hypothesis_test", False))
+
+
+def _say_how_shrunk(report: pytest.TestReport) -> None:
+    """Under a profile that reports counter-examples as found, a failing property says so and how to
+    shrink it (the kit's ``reproduce:`` line replays it either way)."""
+    if profiles.shrinks() or not hasattr(report.longrepr, "addsection"):
+        return
+    report.longrepr.addsection("conformance", (
+        f"counter-example not shrunk: {profiles.describe()} reports the first one found, so that a wrong "
+        "sync's verdict comes as quickly as a right one's. To shrink it, rerun this check with "
+        "--hypothesis-profile shrink (or ci)."))
 
 
 class _Records:

@@ -1,30 +1,37 @@
 """Hypothesis settings for the conformance checks.
 
-Three profiles: Hypothesis' ``default`` (fast: each check runs the few examples it asks for, randomly
-drawn), ``ci`` (``--hypothesis-profile ci``: derandomized, so every CI run tries the same
-examples, and four times as many) and ``triage`` (derandomized, the default's examples, and a
-counter-example is reported as found, not shrunk: for telling right from wrong quickly, as the
-``verdicts`` and ``kill-rate`` commands do). With any other profile the checks take its ``max_examples``.
-Physics steps take milliseconds, so deadlines are off and the "too slow" health check is suppressed.
+Four profiles: Hypothesis' ``default`` (fast: each check runs the few examples it asks for, randomly
+drawn, and reports the first counter-example it finds without shrinking it, so that a wrong sync's
+full verdict takes about as long as a right one's: shrinking a scene run by scene run took minutes);
+``shrink`` (``--hypothesis-profile shrink``: the default's examples, and every counter-example shrunk
+as far as Hypothesis goes), ``ci`` (derandomized, so every CI run tries the same examples, four times
+as many, shrunk) and ``triage`` (derandomized, the default's examples, not shrunk: for telling right
+from wrong quickly, as the ``verdicts`` and ``kill-rate`` commands do). With any other profile the
+checks take its ``max_examples`` and phases. Every failure carries the kit's own ``reproduce:`` line,
+shrunk or not. Physics steps take milliseconds, so deadlines are off and the "too slow" health check is
+suppressed.
 """
 
 from __future__ import annotations
 
 from hypothesis import HealthCheck, Phase, settings
 
-__all__ = ["CI_FACTOR", "app_examples", "check_settings", "describe"]
+__all__ = ["CI_FACTOR", "app_examples", "check_settings", "describe", "shrinks"]
 
 CI_FACTOR = 4
 _SLOW_OK = [HealthCheck.too_slow, HealthCheck.data_too_large, HealthCheck.filter_too_much]
 
 settings.register_profile("ci", derandomize=True, deadline=None, print_blob=True,
                           suppress_health_check=_SLOW_OK)
+_NO_SHRINK = (Phase.explicit, Phase.reuse, Phase.generate)
 settings.register_profile("triage", derandomize=True, deadline=None, print_blob=True,
-                          suppress_health_check=_SLOW_OK,
-                          phases=[Phase.explicit, Phase.reuse, Phase.generate])
+                          suppress_health_check=_SLOW_OK, phases=_NO_SHRINK)
+settings.register_profile("shrink", deadline=None, print_blob=True, suppress_health_check=_SLOW_OK)
 
 #: Examples per profile, as a multiple of what a check asks for under ``default``.
-_FACTORS = {"default": 1, "ci": CI_FACTOR, "triage": 1}
+_FACTORS = {"default": 1, "shrink": 1, "ci": CI_FACTOR, "triage": 1}
+#: Profiles whose counter-examples are reported as found.
+_UNSHRUNK = {"default", "triage"}
 
 
 def _profile() -> str:
@@ -38,7 +45,16 @@ def check_settings(examples: int) -> settings:
         count = examples * _FACTORS[profile]
     else:
         count = settings.default.max_examples
+    if profile in _UNSHRUNK:
+        return settings(max_examples=count, deadline=None, suppress_health_check=_SLOW_OK, print_blob=True,
+                        phases=_NO_SHRINK)
     return settings(max_examples=count, deadline=None, suppress_health_check=_SLOW_OK, print_blob=True)
+
+
+def shrinks() -> bool:
+    """Whether the checks shrink a counter-example under the current profile."""
+    profile = _profile()
+    return profile not in _UNSHRUNK and Phase.shrink in settings.default.phases
 
 
 #: Perturbed runs of an app per profile: each is a whole run of the app in its own process (seconds), so
@@ -53,6 +69,8 @@ def app_examples() -> int:
 
 def describe() -> str:
     profile = _profile()
-    how = {"default": "fast, random examples", "ci": f"derandomized, x{CI_FACTOR} examples",
+    how = {"default": "fast, random examples, counter-examples not shrunk",
+           "shrink": "random examples, counter-examples shrunk",
+           "ci": f"derandomized, x{CI_FACTOR} examples",
            "triage": "derandomized, counter-examples not shrunk"}.get(profile, "user profile")
     return f"hypothesis profile {profile!r} ({how})"

@@ -1,5 +1,6 @@
-"""The README's complete example for the backend in force is a right sync implementation: copied out
-verbatim, it passes (FURY 0.12: ``my_sync.py``; FURY 2: ``my_sync_fury2.py``)."""
+"""The documented complete example for the backend in force is a right sync implementation: copied out
+verbatim, it passes (FURY 2: ``my_sync_fury2.py`` in the README; FURY 0.12: ``my_sync.py`` in
+docs/backends.md)."""
 
 from __future__ import annotations
 
@@ -13,12 +14,12 @@ import background
 from conformance import backends
 from conformance.display import child_environment, dies_with_this_process
 
-README = Path(__file__).resolve().parent.parent / "README.md"
-MODULE = {"vtk": "my_sync", "pygfx": "my_sync_fury2"}[backends.NAME]
+ROOT = Path(__file__).resolve().parent.parent
+MODULE, PAGE = {"vtk": ("my_sync", ROOT / "docs" / "backends.md"), "pygfx": ("my_sync_fury2", ROOT / "README.md")}[backends.NAME]
 
 
 def _check_the_example() -> subprocess.CompletedProcess:
-    text = README.read_text(encoding="utf-8")
+    text = PAGE.read_text(encoding="utf-8")
     example = re.search(rf"Save as `{MODULE}.py`.*?```python\n(.*?)```", text, re.S).group(1)
     with tempfile.TemporaryDirectory() as where:
         (Path(where) / f"{MODULE}.py").write_text(example, encoding="utf-8")
