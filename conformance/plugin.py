@@ -313,6 +313,7 @@ def pytest_runtest_makereport(item: pytest.Item, call):
             "worst": item.stash.get(survey.WORST, None),
             "kinds": survey.kinds_of(item, report, message),
             "message": message.strip().splitlines()[0][:4000] if message.strip() else "",
+            "diagnosis": next((line[len("diagnosis: "):] for line in message.splitlines() if line.startswith("diagnosis: ")), ""),
         }))
     return report
 

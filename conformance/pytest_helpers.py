@@ -19,7 +19,7 @@ from typing import Any, Iterable, Iterator, Mapping, Sequence
 
 import pytest
 
-from conformance import compare, events as events_module, scenes, survey as survey_module
+from conformance import compare, diagnosis, events as events_module, scenes, survey as survey_module
 from conformance.errors import SyncError
 from conformance.survey import WORST  # noqa: F401  (where the plugin and older callers find it)
 from conformance.tolerances import Tolerance
@@ -85,11 +85,26 @@ def _by_ratio(r: Any) -> tuple[bool, float]:
     return (r.error != r.error, r.error / r.tolerance if r.tolerance else r.error)
 
 
-def _vertices_message(failures: Sequence[Any], run: Any, sync: str, worst: Any = None) -> str:
-    """The message of a frame's vertex failures, about ``worst`` (default: the largest error, NaN first)."""
+def _largest(failures: Sequence[Any]) -> Any:
+    return max(failures, key=lambda r: (r.error != r.error, r.error))  # NaN first, then largest
+
+
+def _drawn(run: Any, results: Sequence[Any]) -> dict[str, Any]:
+    """What the failing targets ``results`` are drawn as now, for their diagnoses (made later, if at all)."""
+    index = {t.name: i for i, t in enumerate(run.drawing.targets)}
+    return {r.target: diagnosis.drawn_now(run.drawing, index[r.target], r.frame) for r in results if r.target in index}
+
+
+def _vertices_message(failures: Sequence[Any], run: Any, sync: str, worst: Any = None, drawn=None) -> str:
+    """The message of a frame's vertex failures, about ``worst`` (default: the largest error, NaN first),
+    with the known mistake that explains its drawing (``drawn``: :func:`_drawn`), if one does."""
     if worst is None:
-        worst = max(failures, key=lambda r: (r.error != r.error, r.error))  # NaN first, then largest
+        worst = _largest(failures)
     lines = [f"{worst.describe()} {_context(run, sync, worst.frame)}"]
+    if drawn and worst.target in drawn:
+        found = diagnosis.diagnose(run, drawn[worst.target], worst.tolerance)
+        if found:
+            lines.append(found)
     if len(failures) > 1:
         others = ", ".join(sorted({r.target for r in failures} - {worst.target}))
         lines.append(f"{len(failures)} targets out of tolerance at this frame" + (f" (also: {others[:300]})" if others else ""))
@@ -116,7 +131,7 @@ def assert_vertices_match(results: Iterable[Any], *, run: Any, sync: str) -> Non
     __tracebackhide__ = True
     failures = [r for r in results if not r.ok]
     if failures:
-        pytest.fail(_vertices_message(failures, run, sync), pytrace=False)
+        pytest.fail(_vertices_message(failures, run, sync, drawn=_drawn(run, [_largest(failures)])), pytrace=False)
 
 
 def assert_normals_turn(results: Iterable[Any], *, run: Any, sync: str) -> None:
@@ -204,10 +219,11 @@ class Kit:
         failures = [r for r in results if not r.ok]
         if failures:
             worst = max(failures, key=_by_ratio)
+            drawn = _drawn(run, [worst, _largest(failures)])
             # The figure is the worst in tolerances, and so is its message; the first failure's message
             # stays default mode's own (about the largest error in metres).
-            self._failed("vertices", lambda w=worst: _vertices_message(failures, run, sync, w),
-                         first=lambda: _vertices_message(failures, run, sync), value=worst.error,
+            self._failed("vertices", lambda w=worst: _vertices_message(failures, run, sync, w, drawn),
+                         first=lambda: _vertices_message(failures, run, sync, drawn=drawn), value=worst.error,
                          limit=worst.tolerance, unit="m", frame=worst.frame, target=worst.target)
         turned = [r for r in compare.compare_normals(run.drawing, run.frame, self.tolerance) if not r.ok]
         if turned:

@@ -35,7 +35,7 @@ GUIDE_ACTOR_WRONG = backends.NAME == "vtk"
 @pytest.mark.parametrize("spec", ["wrong_syncs:DoesNothing", "wrong_syncs:TransposedRotation",
                                   *(["guide-actor"] if GUIDE_ACTOR_WRONG else [])])
 def test_every_frame_check_fails_on_a_wrong_pose(spec):
-    with pytest.raises(Failed, match=r"is drawn at .* but should be at .*\[free_fall\(.*frame \d+.*\nreproduce: "):
+    with pytest.raises(Failed, match=r"is drawn at .* but should be at .*\[free_fall\(.*frame \d+.*(\ndiagnosis: .*)?\nreproduce: "):
         checks.test_vertices_match_poses_every_frame("free_fall", kit(spec))
 
 
@@ -47,7 +47,7 @@ def test_every_frame_check_passes_a_right_sync(spec):
 def test_teleport_check_fails_when_a_resting_body_is_teleported():
     # The pendulum's mount is static: a sync that skips bodies at rest never redraws it.
     teleport = Teleport(frame=3, which=0, offset=(0.3, 0.0, 0.2), orientation=(0.0, 0.0, 0.0, 1.0))
-    with pytest.raises(Failed, match=r"'mount' .* should be at .*frame 3.*events .*teleport.*\nreproduce: .*--events"):
+    with pytest.raises(Failed, match=r"'mount' .* should be at .*frame 3.*events .*teleport.*\ndiagnosis: drawn at the pose before the teleport of frame 3.*\nreproduce: .*--events"):
         checks.check_run(kit("wrong_syncs:VelocityGated"), "pendulum", {}, 5, [teleport])
     checks.check_run(kit("reference"), "pendulum", {}, 5, [teleport])
 

@@ -23,7 +23,6 @@ holds but a variant does is diagnosed by it.
 from __future__ import annotations
 
 import functools
-import warnings
 
 from dataclasses import dataclass
 
@@ -31,6 +30,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
+from conformance import poses
 from conformance.tolerances import DEFAULT, Tolerance
 
 __all__ = ["Attachment", "VARIANTS", "attach", "local_coordinates", "variant_fit"]
@@ -187,12 +187,8 @@ def _allowance(vertices, pos, rot, best, tolerance: Tolerance) -> np.ndarray:
 # -- the usual mistakes, as frames ----------------------------------------------------------------
 
 def _vtk_euler(quaternions: np.ndarray) -> np.ndarray:
-    """What ``SetOrientation(*degrees(getEulerFromQuaternion(q)))`` draws: pyBullet's roll, pitch, yaw
-    (about fixed x, y, z) used by VTK as the angles of ``Rz·Rx·Ry`` (measured: intrinsic z, x, y)."""
-    with warnings.catch_warnings():  # at pitch ±90° scipy zeroes one angle, as getEulerFromQuaternion does
-        warnings.simplefilter("ignore", UserWarning)
-        roll, pitch, yaw = Rotation.from_quat(quaternions.reshape(-1, 4)).as_euler("xyz").T
-    return Rotation.from_euler("ZXY", np.stack([yaw, roll, pitch], axis=1)).as_matrix().reshape(quaternions.shape[:-1] + (3, 3))
+    """What ``SetOrientation(*degrees(getEulerFromQuaternion(q)))`` draws (VTK turns about z, then x, then y)."""
+    return poses.euler_matrices(quaternions, "ZXY", (2, 0, 1))
 
 
 def _rotations(quaternions: np.ndarray) -> np.ndarray:

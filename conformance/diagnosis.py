@@ -1,0 +1,217 @@
+"""Which known mistake a wrong drawing is: the catalogue of the usual sync mistakes, as poses.
+
+When a target is drawn out of tolerance, its drawn vertices are tried against the pose each usual
+mistake would have drawn them at (:data:`MISTAKES`); when one pose holds every vertex within twice
+the tolerance (float32 storage rounds the drawing and the kit's own arithmetic rounds the candidate)
+the failure says so in one line, ``diagnosis: …``. A pose that is itself within the tolerance of
+pyBullet's is never offered (it could not explain the error), and a drawing no pose holds gets no
+diagnosis: the catalogue names a mistake only when it reproduces the drawing.
+
+The poses pyBullet had earlier (the previous step, before a teleport or a joint reset) come from
+replaying the run's physics: the scene built again with the same parameters, the same events applied
+at the same frames, stepped without any sync (scenes are deterministic, bit for bit:
+``test_is_deterministic_in_process``). A replay happens only when a failure is reported.
+"""
+
+from __future__ import annotations
+
+import contextlib
+from dataclasses import dataclass
+from typing import Any, Sequence
+
+import numpy as np
+import pybullet
+from scipy.spatial.transform import Rotation
+
+from conformance import poses, truth
+
+__all__ = ["EULER_ORDERS", "MISTAKES", "Drawn", "diagnose", "diagnose_frame", "drawn_now", "explain", "explain_frame"]
+
+#: name → what it means (printed after "diagnosis: ")
+MISTAKES = {
+    "previous-step": "drawn exactly at pyBullet's pose of the previous step (frame {frame}): sync after "
+                     "p.stepSimulation(), and read links with getLinkState(..., computeForwardKinematics=1)",
+    "before-event": "drawn at the pose before the {event} of frame {frame}: the sync did not draw the move (it skips "
+                    "bodies it believes at rest or static, caches poses, or draws the previous step); read every pose "
+                    "at every call, after p.stepSimulation()",
+    "com-frame": "drawn at the centre-of-mass frame ({call}) instead of the link frame: undo the inertial offset, "
+                 "getDynamicsInfo(body, -1)[3:5] for a base, or read links with getLinkState(...)[4:6]",
+    "conjugate": "drawn with the inverse rotation (the conjugate quaternion, or the rotation matrix transposed): "
+                 "a row vector `v @ R` where `R @ v` was meant, or a matrix written by rows into a column-major one",
+    "wxyz": "drawn with the quaternion reordered to (w, x, y, z) and handed to something that takes pyBullet's "
+            "(x, y, z, w): pass pyBullet's quaternion as it is",
+    "scalar-first": "drawn with pyBullet's (x, y, z, w) quaternion read as (w, x, y, z) (transforms3d, Eigen, "
+                    "scipy's scalar_first=True): read it as (x, y, z, w)",
+    "euler-order": "drawn with pyBullet's Euler angles composed in another order than pyBullet's ({order}; "
+                   "getEulerFromQuaternion's angles mean R = Rz(yaw)·Ry(pitch)·Rx(roll), turns about fixed x, y, z): "
+                   "set the rotation from the quaternion",
+    "never-moved": "drawn where it was built: this target's vertices (or its actor's transform) were never updated",
+    "translation-only": "moved but never turned: the position is pyBullet's, the rotation the one it was built with",
+    "rotation-only": "turned but never moved: the rotation is pyBullet's, the position the one it was built with",
+    "other-target": "drawn at the pose of {other}: the vertex range or the actor was paired with the wrong body or link",
+}
+
+
+@dataclass(frozen=True)
+class Drawn:
+    """One failing target's drawn vertices ``(n, 3)`` (world) at ``frame``, and pyBullet's link-frame and
+    centre-of-mass poses of every target then (``now``, ``com``), kept when the failure was found so that
+    its diagnosis can be made later (survey mode reports after the run moved on)."""
+
+    index: int
+    frame: int
+    vertices: np.ndarray
+    now: tuple[np.ndarray, np.ndarray]
+    com: tuple[np.ndarray, np.ndarray]
+
+
+def drawn_now(drawing, index: int, frame: int) -> Drawn:
+    from conformance import backends
+
+    t = drawing.targets[index]
+    p = drawing.world.p
+    items = [(u.body, u.link) for u in drawing.targets]
+    com_pos, com_orn = np.empty((len(items), 3)), np.empty((len(items), 4))
+    for i, (body, link) in enumerate(items):
+        if link < 0:
+            pos, orn = pybullet.getBasePositionAndOrientation(body, physicsClientId=p.client)
+        else:
+            pos, orn = pybullet.getLinkState(body, link, computeForwardKinematics=1, physicsClientId=p.client)[:2]
+        com_pos[i], com_orn[i] = pos, orn
+    return Drawn(index, frame, np.array(backends.world_vertices(t.actor)[t.start:t.stop], dtype=np.float64),
+                 truth.link_frames(p, items), (com_pos, com_orn))
+
+
+@dataclass
+class _Physics:
+    """pyBullet's link-frame poses of every target at the failing frame (``now``), the one before, and
+    just before each event (replayed), and the centre-of-mass poses at the failing frame."""
+
+    now: tuple[np.ndarray, np.ndarray]
+    previous: tuple[np.ndarray, np.ndarray] | None
+    before_events: list[tuple[Any, tuple[np.ndarray, np.ndarray]]]
+    com: tuple[np.ndarray, np.ndarray]
+
+
+def _replay(run, drawn: Drawn) -> _Physics:
+    """The earlier poses, by replaying the run's physics; none when the replay does not reach the poses
+    the run had at the failing frame (physics changed by something other than the run's events)."""
+    from conformance.scenes import build
+
+    frame = drawn.frame
+    items = [(t.body, t.link) for t in run.drawing.targets]
+    by_frame: dict[int, list] = {}
+    for event in run.events:
+        by_frame.setdefault(event.frame, []).append(event)
+    before_events = []
+    previous = None
+    with build(run.scene.name, **dict(run.params)) as scene:
+        for k in range(frame + 1):
+            if k > 0 and k == frame:
+                previous = truth.link_frames(scene.p, items)
+            events = by_frame.get(k, ())
+            if events:
+                before = truth.link_frames(scene.p, items)
+                before_events.extend((e, before) for e in events)
+                for e in events:
+                    e.apply(scene)
+            if k > 0:
+                scene.advance(k - 1)
+        replayed = truth.link_frames(scene.p, items)
+    if not (np.allclose(replayed[0], drawn.now[0], rtol=0, atol=1e-9)
+            and np.allclose(poses.matrices(replayed[1]), poses.matrices(drawn.now[1]), rtol=0, atol=1e-9)):
+        previous, before_events = None, []
+    return _Physics(drawn.now, previous, before_events, drawn.com)
+
+
+#: Euler compositions renderers make of (roll, pitch, yaw): scipy intrinsic order and the angles' order
+EULER_ORDERS = {
+    "VTK's SetOrientation(x, y, z) turns about z, then the turned x, then the turned y: Rz·Rx·Ry": ("ZXY", (2, 0, 1)),
+    "one axis at a time, x, then y, then z about the turned axes (VTK's RotateX/Y/Z), or z, y, x about the "
+    "world axes (FURY 2's rotate): Rx·Ry·Rz": ("XYZ", (0, 1, 2)),
+}
+
+
+def _candidates(run, physics: _Physics, i: int, frame: int):
+    """``(name, words, position, matrix)`` of every mistake's pose for target ``i`` at ``frame``."""
+    t = run.drawing.targets[i]
+    p, q = physics.now[0][i], physics.now[1][i]
+    built_p, built_q = np.asarray(t.position, dtype=np.float64), np.asarray(t.orientation, dtype=np.float64)
+    r = poses.matrices(q)
+    # An event of this very frame first: the pose before it is also the previous step's, and "missed the
+    # move" covers both; then the previous step; then the poses before earlier events, latest first.
+    latest = [(e, b) for e, b in physics.before_events if e.frame == frame]
+    earlier = [(e, b) for e, b in physics.before_events if e.frame < frame]
+    for event, before in latest:
+        yield "before-event", {"event": _event_name(event), "frame": event.frame}, *_pose(before, i)
+    if physics.previous is not None:
+        yield "previous-step", {"frame": frame - 1}, *_pose(physics.previous, i)
+    for event, before in reversed(earlier):
+        yield "before-event", {"event": _event_name(event), "frame": event.frame}, *_pose(before, i)
+    com_call = "getBasePositionAndOrientation" if t.link < 0 else "getLinkState(...)[0:2]"
+    yield "com-frame", {"call": com_call}, physics.com[0][i], poses.matrices(physics.com[1][i])
+    yield "conjugate", {}, p, r.T
+    yield "wxyz", {}, p, poses.matrices(np.roll(q, 1))
+    yield "scalar-first", {}, p, poses.matrices(np.roll(q, -1))
+    for words, (order, which) in EULER_ORDERS.items():
+        yield "euler-order", {"order": words}, p, poses.euler_matrices(q, order, which)
+    yield "never-moved", {}, built_p, poses.matrices(built_q)
+    yield "translation-only", {}, p, poses.matrices(built_q)
+    yield "rotation-only", {}, built_p, r
+    for j, other in enumerate(run.drawing.targets):
+        if j != i:
+            yield "other-target", {"other": f"{other.name!r}"}, physics.now[0][j], poses.matrices(physics.now[1][j])
+
+
+def _pose(frames, i):
+    return frames[0][i], poses.matrices(frames[1][i])
+
+
+def _event_name(event) -> str:
+    name = type(event).__name__
+    return {"Teleport": "teleport", "JointReset": "joint reset", "Kick": "kick"}.get(name, name.lower())
+
+
+def explain(run, drawn: Drawn, tolerance: float) -> tuple[str, str] | None:
+    """``(mistake, line)`` for target ``drawn.index`` drawn as ``drawn.vertices`` at ``drawn.frame`` with
+    per-vertex ``tolerance`` (metres): the first mistake of :data:`MISTAKES` whose pose holds every drawn
+    vertex, and the ``diagnosis: …`` line saying so; None when none does."""
+    local = run.drawing.local[drawn.index]
+    if not len(local) or not np.all(np.isfinite(drawn.vertices)):
+        return None
+    try:
+        physics = _replay(run, drawn)
+    except Exception:  # a diagnosis is a courtesy: a replay that cannot be made gives none
+        return None
+    true_p, true_r = _pose(physics.now, drawn.index)
+    truth_vertices = local @ true_r.T + true_p
+    allowance = 2 * tolerance
+    for name, words, position, matrix in _candidates(run, physics, drawn.index, drawn.frame):
+        expected = local @ np.asarray(matrix).T + position
+        if np.max(np.linalg.norm(expected - truth_vertices, axis=1)) <= tolerance:
+            continue  # this mistake would have drawn it right here: it cannot explain the error
+        if np.max(np.linalg.norm(expected - drawn.vertices, axis=1)) <= allowance:
+            return name, "diagnosis: " + MISTAKES[name].format(**words)
+    return None
+
+
+def diagnose(run, drawn: Drawn, tolerance: float) -> str:
+    """The ``diagnosis: …`` line of :func:`explain`, or ``""``."""
+    found = explain(run, drawn, tolerance)
+    return found[1] if found else ""
+
+
+def explain_frame(run, results) -> tuple[str, str] | None:
+    """:func:`explain` for the worst (in tolerances) failing vertex result of ``run`` as it stands now."""
+    failing = [r for r in results if not r.ok]
+    if not failing:
+        return None
+    worst = max(failing, key=lambda r: r.error / r.tolerance if r.tolerance else r.error)
+    index = {t.name: i for i, t in enumerate(run.drawing.targets)}
+    return explain(run, drawn_now(run.drawing, index[worst.target], worst.frame), worst.tolerance)
+
+
+def diagnose_frame(run, results) -> str:
+    """The ``diagnosis: …`` line of :func:`explain_frame`, or ``""``."""
+    found = explain_frame(run, results)
+    return found[1] if found else ""
