@@ -161,7 +161,9 @@ def test_killing_the_xdist_controller_leaves_no_worker_and_no_xvfb(tmp_path, sig
     pytest.importorskip("xdist")
     process = _pytest(tmp_path, "-n", "2")
     xvfbs = _wait_for_xvfbs(process, 2)  # one per worker, each its worker's child
-    workers = [pid for pid in _descendants(process.pid) if pid not in xvfbs and _stat(pid)[0] != "Xvfb"]
+    # A descendant may exit between the listing and its stat (a short-lived helper): it is no worker to watch.
+    workers = [pid for pid in _descendants(process.pid)
+               if pid not in xvfbs and (stat := _stat(pid)) is not None and stat[0] != "Xvfb"]
     assert workers, "no worker processes found"
     status = _kill(process, signum)
     assert status == -signum
