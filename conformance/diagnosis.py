@@ -15,13 +15,11 @@ at the same frames, stepped without any sync (scenes are deterministic, bit for 
 
 from __future__ import annotations
 
-import contextlib
 from dataclasses import dataclass
-from typing import Any, Sequence
+from typing import Any
 
 import numpy as np
 import pybullet
-from scipy.spatial.transform import Rotation
 
 from conformance import poses, truth
 
@@ -65,10 +63,10 @@ class Drawn:
     com: tuple[np.ndarray, np.ndarray]
 
 
-def drawn_now(drawing, index: int, frame: int) -> Drawn:
+def drawn_now(drawing, names, frame: int) -> dict[str, Drawn]:
+    """What the targets named ``names`` are drawn as now, with pyBullet's poses of every target read once."""
     from conformance import backends
 
-    t = drawing.targets[index]
     p = drawing.world.p
     items = [(u.body, u.link) for u in drawing.targets]
     com_pos, com_orn = np.empty((len(items), 3)), np.empty((len(items), 4))
@@ -78,8 +76,13 @@ def drawn_now(drawing, index: int, frame: int) -> Drawn:
         else:
             pos, orn = pybullet.getLinkState(body, link, computeForwardKinematics=1, physicsClientId=p.client)[:2]
         com_pos[i], com_orn[i] = pos, orn
-    return Drawn(index, frame, np.array(backends.world_vertices(t.actor)[t.start:t.stop], dtype=np.float64),
-                 truth.link_frames(p, items), (com_pos, com_orn))
+    now = truth.link_frames(p, items)
+    found = {}
+    for i, t in enumerate(drawing.targets):
+        if t.name in names:
+            vertices = np.array(backends.world_vertices(t.actor)[t.start:t.stop], dtype=np.float64)
+            found[t.name] = Drawn(i, frame, vertices, now, (com_pos, com_orn))
+    return found
 
 
 @dataclass
@@ -207,8 +210,8 @@ def explain_frame(run, results) -> tuple[str, str] | None:
     if not failing:
         return None
     worst = max(failing, key=lambda r: r.error / r.tolerance if r.tolerance else r.error)
-    index = {t.name: i for i, t in enumerate(run.drawing.targets)}
-    return explain(run, drawn_now(run.drawing, index[worst.target], worst.frame), worst.tolerance)
+    drawn = drawn_now(run.drawing, {worst.target}, worst.frame)
+    return explain(run, drawn[worst.target], worst.tolerance) if worst.target in drawn else None
 
 
 def diagnose_frame(run, results) -> str:

@@ -91,8 +91,7 @@ def _largest(failures: Sequence[Any]) -> Any:
 
 def _drawn(run: Any, results: Sequence[Any]) -> dict[str, Any]:
     """What the failing targets ``results`` are drawn as now, for their diagnoses (made later, if at all)."""
-    index = {t.name: i for i, t in enumerate(run.drawing.targets)}
-    return {r.target: diagnosis.drawn_now(run.drawing, index[r.target], r.frame) for r in results if r.target in index}
+    return diagnosis.drawn_now(run.drawing, {r.target for r in results}, results[0].frame)
 
 
 def _vertices_message(failures: Sequence[Any], run: Any, sync: str, worst: Any = None, drawn=None) -> str:
