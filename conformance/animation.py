@@ -10,6 +10,8 @@ chosen frame, and writes the animation; what is guaranteed:
 * a failing frame has a red border (:data:`BORDER_RED`, :func:`border_width` pixels wide) and the
   caption "frame N: <its worst problem>" on red; a passing frame has no red border, only a small
   "frame N" caption;
+* on a frame where targets are drawn out of tolerance, each such target's outline where pyBullet has
+  it (:mod:`conformance.rendering.outline`, magenta) is drawn over the sync's picture;
 * the file is written whole or not at all (:func:`conformance.files.write_atomically`); an MP4
   needs ``imageio-ffmpeg``, and without it :func:`check_writer` refuses before anything runs.
 """
@@ -55,6 +57,7 @@ class FrameCheck:
     problems: tuple[str, ...]
     worst_vertex: str  # the worst vertex of any target, failing or not (what `check -v` prints)
     worst_problem: str | None  # the failing target furthest out of tolerance; None when the frame passes
+    misplaced: tuple[str, ...] = ()  # targets whose vertices are out of tolerance: their outline is drawn
 
     @property
     def ok(self) -> bool:
@@ -80,7 +83,8 @@ def check_frame(run, frame: int) -> FrameCheck:
     problems = tuple([text for _, text in ranked] + unannounced)
     worst = max(vertices, key=lambda r: _ratio(r.error, r.tolerance)).describe() if vertices else "no targets"
     worst_problem = max(ranked, key=lambda item: item[0])[1] if ranked else (unannounced[0] if unannounced else None)
-    return FrameCheck(frame=frame, problems=problems, worst_vertex=worst, worst_problem=worst_problem)
+    return FrameCheck(frame=frame, problems=problems, worst_vertex=worst, worst_problem=worst_problem,
+                      misplaced=tuple(r.target for r in vertices if not r.ok))
 
 
 # -- marking pictures --------------------------------------------------------------------------------
@@ -143,6 +147,14 @@ def mark(picture: np.ndarray, check: FrameCheck) -> np.ndarray:
     draw.rectangle([inset, inset, inset + box_width - 1, inset + box_height - 1], fill=box_colour)
     for i, line in enumerate(lines):
         draw.text((inset + pad, inset + pad + i * line_height), line, fill=text_colour, font=font)
+    if check.misplaced:  # say what the outline is, in its colour, bottom left
+        from conformance.rendering.outline import OUTLINE_COLOUR
+
+        legend = "outline: where pyBullet has it"
+        legend_width = min(width - 2 * inset, int(draw.textlength(legend, font=font)) + 2 * pad)
+        top = height - inset - line_height - 2 * pad
+        draw.rectangle([inset, top, inset + legend_width - 1, height - inset - 1], fill=(255, 255, 255))
+        draw.text((inset + pad, top + pad), legend, fill=OUTLINE_COLOUR, font=font)
     marked = np.asarray(image).copy()
     if not check.ok:
         marked[:inset, :] = BORDER_RED
@@ -207,6 +219,7 @@ def record(scene: str, implementation, frames: range, out: Path, *, size: tuple[
     and write the animation to ``out``. Needs a display (:func:`conformance.display.ensure_display`)."""
     from conformance import backends, files, runner
     from conformance.progress import progress
+    from conformance.rendering import outline
 
     check_writer(out)
     pictures = []
@@ -218,6 +231,9 @@ def record(scene: str, implementation, frames: range, out: Path, *, size: tuple[
             run.advance(frame - run.frame)
             check = check_frame(run, frame)
             animation.checks.append(check)
-            pictures.append(mark(backends.render(run.drawing, run.scene.camera, size), check))
+            picture = backends.render(run.drawing, run.scene.camera, size)
+            if check.misplaced:
+                picture = outline.draw(picture, outline.expected_outline(run, check.misplaced, size))
+            pictures.append(mark(picture, check))
     files.write_atomically(out, encode(pictures, out))
     return animation

@@ -3,9 +3,11 @@
 When a target is drawn out of tolerance, its drawn vertices are tried against the pose each usual
 mistake would have drawn them at (:data:`MISTAKES`); when one pose holds every vertex within twice
 the tolerance (float32 storage rounds the drawing and the kit's own arithmetic rounds the candidate)
-the failure says so in one line, ``diagnosis: …``. A pose that is itself within the tolerance of
-pyBullet's is never offered (it could not explain the error), and a drawing no pose holds gets no
-diagnosis: the catalogue names a mistake only when it reproduces the drawing.
+the failure says so in one line, ``diagnosis: …``. A pose within :data:`DISTINCT` allowances of
+pyBullet's is never offered (the drawing could be nearer the truth than the mistake), and a drawing no
+pose holds gets no diagnosis: the catalogue names a mistake only when it reproduces the drawing. A
+target whose vertices are right and whose stored normals are not is tried the same way against the
+normals' mistakes (:data:`NORMAL_MISTAKES`), and a change never announced is named as such.
 
 The poses pyBullet had earlier (the previous step, before a teleport or a joint reset) come from
 replaying the run's physics: the scene built again with the same parameters, the same events applied
@@ -23,7 +25,8 @@ import pybullet
 
 from conformance import poses, truth
 
-__all__ = ["EULER_ORDERS", "MISTAKES", "Drawn", "diagnose", "diagnose_frame", "drawn_now", "explain", "explain_frame"]
+__all__ = ["EULER_ORDERS", "MISTAKES", "NORMAL_MISTAKES", "Drawn", "diagnose", "diagnose_frame", "diagnose_normals",
+           "diagnose_problems", "drawn_now", "explain", "explain_frame", "explain_normals", "unannounced"]
 
 #: name → what it means (printed after "diagnosis: ")
 MISTAKES = {
@@ -48,6 +51,33 @@ MISTAKES = {
     "rotation-only": "turned but never moved: the rotation is pyBullet's, the position the one it was built with",
     "other-target": "drawn at the pose of {other}: the vertex range or the actor was paired with the wrong body or link",
 }
+
+#: name → what it means, for a target whose vertices are right and whose stored normals are not
+NORMAL_MISTAKES = {
+    "stale-normals": "the normals buffer is as built, never turned: the sync rewrote the positions but not the "
+                     "normals; turn the normals by the same rotation (or move the actor by its matrix, which turns both)",
+    "normals-previous-step": "the normals are turned as the body was at the previous step (frame {frame}) while "
+                             "the positions are current: turn both from the pose read after p.stepSimulation()",
+    "stale-or-late-normals": "the normals buffer is as built, never turned, or turned a step late: the body's rotation "
+                             "at the previous step (frame {frame}) is still the one it was built with, so the two "
+                             "cannot be told apart yet; turn the normals with the positions, from the pose read after "
+                             "p.stepSimulation()",
+    "normals-twice": "the normals are turned twice: the sync turned the normals in the buffer and the actor's matrix "
+                     "turns them again; turn them in one place only",
+    "normals-inverse": "the normals are turned by the inverse rotation (the conjugate quaternion, or the matrix "
+                       "transposed) while the positions are turned right: use the positions' rotation for both",
+    "normals-dropped": "the actor stores no normals any more (its geometry was replaced without them), so it is lit "
+                       "flat or not at all: keep the normals array and turn it with the positions",
+    "unannounced": "a change never announced to the renderer: the sync wrote the vertex data but did not mark it "
+                   "modified ({announce}), so a live window keeps drawing the old vertices; announce every buffer "
+                   "it changes, each time it changes it",
+}
+
+
+#: A mistake is named only when its pose is this many allowances from pyBullet's, so that a drawing
+#: within the allowance of the mistake is nearer the mistake than the truth (a drawing halfway between
+#: the two, e.g. a rotation by half the angle, is never named).
+DISTINCT = 2
 
 
 @dataclass(frozen=True)
@@ -191,8 +221,8 @@ def explain(run, drawn: Drawn, tolerance: float) -> tuple[str, str] | None:
     allowance = 2 * tolerance
     for name, words, position, matrix in _candidates(run, physics, drawn.index, drawn.frame):
         expected = local @ np.asarray(matrix).T + position
-        if np.max(np.linalg.norm(expected - truth_vertices, axis=1)) <= tolerance:
-            continue  # this mistake would have drawn it right here: it cannot explain the error
+        if np.max(np.linalg.norm(expected - truth_vertices, axis=1)) <= DISTINCT * allowance:
+            continue  # this mistake would have drawn it (nearly) right here: it cannot explain the error
         if np.max(np.linalg.norm(expected - drawn.vertices, axis=1)) <= allowance:
             return name, "diagnosis: " + MISTAKES[name].format(**words)
     return None
@@ -218,3 +248,88 @@ def diagnose_frame(run, results) -> str:
     """The ``diagnosis: …`` line of :func:`explain_frame`, or ``""``."""
     found = explain_frame(run, results)
     return found[1] if found else ""
+
+
+def explain_normals(run, result) -> tuple[str, str] | None:
+    """``(mistake, line)`` for a failing normals result (:class:`conformance.compare.NormalResult`): the
+    first of :data:`NORMAL_MISTAKES` whose rotation turns the target's built normals into the drawn ones
+    within twice the angle tolerance; None when none does (or the target's vertices are wrong too,
+    which the vertex diagnosis covers)."""
+    from conformance import backends
+
+    names = [t.name for t in run.drawing.targets]
+    if result.target not in names:
+        return None
+    i = names.index(result.target)
+    t, local = run.drawing.targets[i], run.drawing.local_normals[i]
+    if local is None:
+        return None
+    stored = backends.world_normals(t.actor)
+    if stored is None:
+        return "normals-dropped", "diagnosis: " + NORMAL_MISTAKES["normals-dropped"]
+    drawn = np.asarray(stored, dtype=np.float64)[t.start:t.stop]
+    if drawn.shape != local.shape or not np.all(np.isfinite(drawn)):
+        return None
+    now = truth.link_frames(run.drawing.world.p, [(u.body, u.link) for u in run.drawing.targets])
+    r = poses.matrices(now[1][i])
+    unit = local / np.linalg.norm(local, axis=1, keepdims=True)
+    drawn = drawn / np.linalg.norm(drawn, axis=1, keepdims=True)
+    allowance = 2 * result.tolerance
+
+    def candidates():
+        try:
+            previous = _replay(run, Drawn(i, result.frame, drawn, now, now)).previous
+        except Exception:  # a diagnosis is a courtesy: a replay that cannot be made gives none
+            previous = None
+        if previous is not None:
+            yield "normals-previous-step", {"frame": result.frame - 1}, poses.matrices(previous[1][i])
+        yield "stale-normals", {}, poses.matrices(np.asarray(t.orientation, dtype=np.float64))
+        yield "normals-twice", {}, r @ r
+        yield "normals-inverse", {}, r.T
+
+    held = []
+    for name, words, matrix in candidates():
+        candidate = unit @ matrix.T
+        if np.max(_angles(candidate, unit @ r.T)) <= DISTINCT * allowance:
+            continue  # this mistake would have lit it (nearly) right here: it cannot explain the error
+        if np.max(_angles(candidate, drawn)) <= allowance:
+            held.append((name, words))
+    if not held:
+        return None
+    name, words = held[0]
+    if [n for n, _ in held[:2]] == ["normals-previous-step", "stale-normals"]:
+        name = "stale-or-late-normals"  # the previous step's rotation is still the built one
+    return name, "diagnosis: " + NORMAL_MISTAKES[name].format(**words)
+
+
+def _angles(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return np.arccos(np.clip(np.einsum("kj,kj->k", a, b), -1.0, 1.0))
+
+
+def diagnose_normals(run, result) -> str:
+    """The ``diagnosis: …`` line of :func:`explain_normals`, or ``""``."""
+    found = explain_normals(run, result)
+    return found[1] if found else ""
+
+
+def unannounced() -> str:
+    """The ``diagnosis: …`` line of a change the sync made without announcing it."""
+    from conformance import backends
+
+    return "diagnosis: " + NORMAL_MISTAKES["unannounced"].format(announce=backends.ANNOUNCE)
+
+
+def diagnose_problems(run) -> str:
+    """The diagnosis of the worst problem of ``run`` as it stands now, in the order the checks report
+    them: wrong vertices, then wrong normals, then a change not announced; ``""`` when none is known."""
+    from conformance import compare
+
+    vertices = compare.compare_vertices(run.drawing, run.frame)
+    if not all(r.ok for r in vertices):
+        return diagnose_frame(run, vertices)
+    normals = [r for r in compare.compare_normals(run.drawing, run.frame) if not r.ok]
+    if normals:
+        return diagnose_normals(run, max(normals, key=lambda r: r.angle))
+    if any(frame == run.frame for frame, _ in run.unannounced):
+        return unannounced()
+    return ""

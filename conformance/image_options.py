@@ -120,7 +120,7 @@ class Pictures:
                             for r in (record.to_json() for record in records) if "renderer" in r["details"]})
         header = [f"sync under test: {sync}", backends.describe(), f"versions: {versions}",
                   *(f"renderer: {r}" for r in renderers), self.describe()]
-        self.report_path = report.write_report(records, self.results, title="FURY–pyBullet image checks",
+        self.report_path = report.write_report(records, self.results, title="FURY–pyBullet conformance: checks with pictures",
                                                header_lines=header)
         return self.report_path
 
@@ -133,7 +133,7 @@ class Pictures:
                 terminalreporter.write_line(line)
         path = getattr(self, "report_path", None)
         if path is not None:
-            terminalreporter.write_line(f"conformance: image checks report: {path}")
+            terminalreporter.write_line(f"conformance: report (image checks, failing vertex checks): {path}")
 
 
 def from_config(config) -> Pictures:

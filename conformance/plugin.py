@@ -294,6 +294,11 @@ def pytest_runtest_makereport(item: pytest.Item, call):
     from conformance import survey
 
     survey.settle(item, report)  # survey mode: a check that noted failures fails now, naming every kind
+    if report.when == "call":
+        from conformance import image_options
+        from conformance.rendering import misplaced
+
+        misplaced.keep(item, report, image_options.from_config(item.config))
     if report.when == "call" and report.failed and _is_property(item):
         _say_how_shrunk(report)
     if report.when == "call" or report.outcome != "passed":

@@ -19,6 +19,7 @@ run (``-k`` narrows the shared run too); under pytest-xdist the checks of one sc
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from types import SimpleNamespace
 from typing import Any, Callable
@@ -26,6 +27,7 @@ from typing import Any, Callable
 import pytest
 
 from conformance import scenes, survey as survey_module
+from conformance.rendering import misplaced
 from conformance.errors import SyncError
 
 __all__ = ["Watcher", "WATCHERS", "report", "seen", "watcher"]
@@ -138,6 +140,10 @@ def _replay(kit, stash: dict) -> None:
     found = stash.get(survey_module.SURVEY)
     if found is None or not found.kinds:
         return
+    picture = stash.get(misplaced.PICTURE)
+    if picture is not None and node is not None and misplaced.PICTURE not in node.stash:
+        record, images = picture  # the watcher's failing frame, in this check's report
+        node.stash[misplaced.PICTURE] = (dataclasses.replace(record, nodeid=getattr(node, "nodeid", "")), images)
     if kit.survey is not None:
         kit.survey.merge(found)
         return

@@ -17,6 +17,7 @@ import pytest
 from PIL import Image, ImageSequence
 
 from conformance import animation, cli, scenes
+from conformance.rendering import outline
 from conformance.pytest_helpers import reproduce_command
 
 
@@ -81,11 +82,48 @@ def test_wrong_sync_gets_its_failing_frames_marked(tmp_path):
     bad = _frames(tmp_path / "bad.gif")
     assert [frame for frame, picture in zip(range(0, 21, 10), bad) if _red_border(picture)] == failing
     assert f"frame {failing[0]}: " in out and "worst: " in out
+    # Where pyBullet has the misdrawn bodies is outlined on exactly the failing frames.
+    assert [frame for frame, picture in zip(range(0, 21, 10), bad) if _outlined(picture)] == failing
     status, out, err = _render([*argv, "--gif", "good.gif"], tmp_path)
     assert status == 0, out + err
     good = _frames(tmp_path / "good.gif")
     assert len(good) == len(bad) == 3
     assert not any(_red_border(p) for p in good) and all(_no_red_edge(p) for p in good)
+    assert not any(_outlined(p) for p in good)
+
+
+def _outlined(picture: np.ndarray) -> bool:
+    return bool((picture == outline.OUTLINE_COLOUR).all(axis=2).sum() > 20)
+
+
+def test_the_outline_is_the_edge_of_the_regions_it_outlines():
+    ids = np.full((20, 30), -1)
+    ids[5:15, 5:15] = 0  # a 10 px square
+    ids[5:15, 15:25] = 1  # touching another target
+    ring = outline.edges(ids, [0])
+    assert ring.sum() == 100 - 36 and not ring[ids != 0].any(), "two pixels wide, inside the square only"
+    assert not outline.edges(ids, [2]).any(), "a target pyBullet does not show has no outline"
+    ids[:, :] = 0  # a target covering the whole picture is outlined along the picture's border
+    assert outline.edges(ids, [0]).sum() == 20 * 30 - 16 * 26
+
+
+def test_the_outline_is_drawn_where_pybullet_has_the_body_and_a_right_drawing_fills_it():
+    from conformance import backends, runner, sync
+    from conformance.rendering import silhouettes
+
+    size = (200, 150)
+    for spec, inside in (("reference", 0.99), ("wrong_syncs:OneStepLate", None)):
+        with runner.running("free_fall", sync.load(spec)) as run:
+            run.advance(100)
+            ring = outline.expected_outline(run, ["body"], size)
+            mask = silhouettes.pybullet_mask(run.scene, run.scene.bindings, run.scene.camera, size)
+            assert ring.any() and not ring[mask != 0].any(), "outline pixels are pyBullet's pixels of the body"
+            drawn = backends.render_ids(run.drawing, run.scene.camera, size) == 0
+            covered = drawn[ring].mean()
+            if inside is not None:  # the right drawing covers its outline (up to an edge pixel)
+                assert covered >= inside, covered
+            else:  # a step late (measured at frame 100: 84 % covered) leaves part of the outline bare
+                assert covered < 0.9, covered
 
 
 def test_frames_that_pass_and_frames_that_fail_in_one_animation(tmp_path):

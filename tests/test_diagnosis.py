@@ -29,6 +29,51 @@ class SwappedPoses(PerTargetSync):
         self.draw((t, *found[(i + 1) % len(found)]) for i, t in enumerate(self.targets))
 
 
+class NormalsInverse(wrong_syncs.Baseline):
+    """Moves shared actors' vertices right but turns their stored normals by the inverse rotation."""
+
+    def place_shared(self, t, pos, orn):
+        rotation = self.matrix(orn)
+        self.vertex_view(t.actor)[t.start:t.stop] = self.local[t.name] @ rotation.T + pos
+        if t.name in self.local_normals:
+            self.normal_view(t.actor)[t.start:t.stop] = self.local_normals[t.name] @ rotation
+
+
+class NormalsTwice(wrong_syncs.Baseline):
+    """Moves shared actors' vertices right but turns their stored normals twice."""
+
+    def place_shared(self, t, pos, orn):
+        rotation = self.matrix(orn)
+        self.vertex_view(t.actor)[t.start:t.stop] = self.local[t.name] @ rotation.T + pos
+        if t.name in self.local_normals:
+            self.normal_view(t.actor)[t.start:t.stop] = self.local_normals[t.name] @ (rotation @ rotation).T
+
+
+class NormalsHalfTurned(wrong_syncs.Baseline):
+    """Moves shared actors' vertices right but turns their stored normals by half the body's rotation."""
+
+    def place_shared(self, t, pos, orn):
+        from scipy.spatial.transform import Rotation, Slerp
+
+        self.vertex_view(t.actor)[t.start:t.stop] = self.local[t.name] @ self.matrix(orn).T + pos
+        if t.name in self.local_normals:
+            half = Slerp([0, 1], Rotation.from_quat([t.orientation, orn]))(0.5).as_matrix()
+            self.normal_view(t.actor)[t.start:t.stop] = self.local_normals[t.name] @ half.T
+
+
+class NormalsOneStepLate(wrong_syncs.Baseline):
+    """Moves shared actors' vertices right but turns their stored normals by the previous call's rotation."""
+
+    def place_shared(self, t, pos, orn):
+        late = getattr(self, "_late", {})
+        self._late = late
+        self.vertex_view(t.actor)[t.start:t.stop] = self.local[t.name] @ self.matrix(orn).T + pos
+        if t.name in self.local_normals:
+            rotation = self.matrix(late.get(t.name, orn))
+            self.normal_view(t.actor)[t.start:t.stop] = self.local_normals[t.name] @ rotation.T
+        late[t.name] = orn
+
+
 def _implementation(spec):
     if isinstance(spec, str):
         return sync.load(spec)
@@ -77,6 +122,49 @@ def test_a_mistake_in_the_catalogue_gets_its_diagnosis(spec, scene, run_events, 
 def test_a_mistake_outside_the_catalogue_gets_no_diagnosis(spec, scene):
     frames = 3000 if scene == "tumbling" else 131
     assert first_diagnosis(spec, scene, frames)[1] is None
+
+
+def first_problem_diagnosis(spec, scene: str, frames: int, **params) -> tuple[int, str]:
+    """The frame of the first problem of any kind ``check`` reports, and its diagnosis line."""
+    from conformance.animation import check_frame
+
+    with runner.running(scene, _implementation(spec), **params) as run:
+        for frame in range(frames + 1):
+            if frame:
+                run.advance()
+            if not check_frame(run, frame).ok:
+                return frame, diagnosis.diagnose_problems(run)
+    raise AssertionError(f"{spec} drew {scene} right for {frames} frames: no failure to diagnose")
+
+
+@pytest.mark.parametrize("spec, words", [
+    ("wrong_syncs:NormalsNotRotated", "as built"),
+    (NormalsOneStepLate, "step late"),
+    (NormalsInverse, "inverse rotation"),
+    (NormalsTwice, "turned twice"),
+    ("wrong_syncs:ForgetsModified", "never announced"),
+], ids=lambda v: getattr(v, "__name__", None) or (v.split(":")[-1] if isinstance(v, str) else None))
+def test_right_vertices_with_a_known_mistake_in_normals_or_announcements_get_its_diagnosis(spec, words):
+    # Shared sphere actors (mixed_shapes by kind) store normals; every body turns from the first step.
+    frame, line = first_problem_diagnosis(spec, "mixed_shapes", 30, grouping="by_kind")
+    assert line.startswith("diagnosis: ") and words in line, (frame, line)
+
+
+def test_normals_a_step_late_are_told_from_stale_ones_once_the_body_has_turned():
+    # At frame 1 the previous rotation is the built one (both mistakes fit, and the line says so);
+    # from frame 2 on each mistake is named alone.
+    for spec, mistake in (("wrong_syncs:NormalsNotRotated", "stale-normals"), (NormalsOneStepLate, "normals-previous-step")):
+        with runner.running("mixed_shapes", _implementation(spec), grouping="by_kind") as run:
+            run.advance(5)
+            turned = [r for r in compare.compare_normals(run.drawing, run.frame) if not r.ok]
+            assert diagnosis.explain_normals(run, max(turned, key=lambda r: r.angle))[0] == mistake
+
+
+def test_wrong_normals_outside_the_catalogue_get_no_diagnosis():
+    # Normals turned by half the body's rotation since it was built: halfway between "as built" and
+    # right, which no catalogued rotation gives.
+    frame, line = first_problem_diagnosis(NormalsHalfTurned, "mixed_shapes", 60, grouping="by_kind")
+    assert line == "", (frame, line)
 
 
 def test_the_diagnosis_is_under_the_failure_of_a_check_and_of_check(capsys):

@@ -198,7 +198,7 @@ def test_the_report_is_one_self_contained_page_with_failures_first(tmp_path, wor
     assert page.count('src="data:image/png;base64,') == 8  # two failures' three pictures, a pass's two
     statuses = re.findall(r'data-status="(\w+)"', page)
     assert statuses == ["failed", "failed", "passed", "passed", "passed"]
-    assert "2 failed" in page and "5 image checks" in page
+    assert "2 failed" in page and "5 checks with pictures" in page
     assert "Image checks &lt;sync &#x27;x&#x27;&gt;" in page
     assert "tolerance set: other-renderer" in page
     assert "physics: differs at &#x27;box3&#x27;: 0.002 m (tolerance 1e-06 m)" in page
@@ -222,7 +222,7 @@ def test_the_report_survives_missing_pictures_and_empty_runs_and_stays_in_its_di
     record = golden(images={"actual": "golden/free_fall/frame60-actual.png", "expected": "../secret.png"})
     page = report.render_report([record], tmp_path / "results")
     assert page.count("picture missing") == 2 and "base64" not in page
-    assert "No image checks were recorded" in report.render_report([], tmp_path)
+    assert "No checks with pictures were recorded" in report.render_report([], tmp_path)
 
 
 @pytest.mark.skipif(shutil.which("chromium") is None, reason="chromium is not installed")

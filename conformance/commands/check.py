@@ -26,7 +26,7 @@ def add_arguments(parser) -> None:
 
 
 def run(args, extra) -> int:
-    from conformance import compare, diagnosis, events, runner, scenes, sync
+    from conformance import diagnosis, events, runner, scenes, sync
     from conformance.animation import check_frame
 
     spec = scenes.get(args.scene)
@@ -47,8 +47,7 @@ def run(args, extra) -> int:
                 for line in check.problems[:5]:
                     print(f"    {line}")
             if check.problems and first_failure is None:
-                first_failure = (frame, check.problems[0],
-                                 diagnosis.diagnose_frame(run, compare.compare_vertices(run.drawing, frame)))
+                first_failure = (frame, check.problems[0], diagnosis.diagnose_problems(run))
     if first_failure is None:
         print(f"PASS {args.scene} with sync {args.sync!r}: every target within tolerance for frames 0..{frames}")
         return 0

@@ -50,6 +50,7 @@ ROLES: dict[str, tuple[str, ...]] = {
     "golden": ("expected", "actual", "difference"),
     "silhouette": ("pybullet_mask", "fury_mask", "mask_difference"),
     "framing": ("actual",),
+    "vertices": ("outlined",),
 }
 
 _RECORDS_GLOB = "records-*.jsonl"

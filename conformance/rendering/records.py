@@ -14,7 +14,7 @@ from typing import Any
 __all__ = ["ImageCheck"]
 
 #: The kinds of image check.
-KINDS = ("golden", "silhouette", "framing")
+KINDS = ("vertices", "golden", "silhouette", "framing")
 
 
 @dataclass
@@ -22,7 +22,8 @@ class ImageCheck:
     """One image check.
 
     ``kind``: ``golden`` (a render against a committed golden), ``silhouette`` (FURY's silhouette of
-    each target against pyBullet's own renderer), ``framing`` (every body on screen and large enough).
+    each target against pyBullet's own renderer), ``framing`` (every body on screen and large enough),
+    ``vertices`` (a vertex check's failing frame, pictured with pyBullet's outline: :mod:`.misplaced`).
     ``metrics`` are the measured numbers and ``limits`` the bounds they were held to, by the same keys
     where a key has a bound (e.g. ``differing_fraction`` ≤ ``limits["differing_fraction"]``; for a
     silhouette, ``iou`` of the worst target ≥ ``limits["iou"]``). ``images`` maps a role (``expected``,

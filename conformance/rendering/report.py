@@ -1,4 +1,4 @@
-"""One self-contained HTML page over every image check of a run.
+"""One self-contained HTML page over every image check of a run, and every failing vertex check's picture.
 
 Guarantees: the page needs nothing but itself (pictures are embedded as base64 ``data:`` URIs read
 from the PNGs :mod:`.artefacts` wrote; no external stylesheet, script, font or image), every string
@@ -10,7 +10,8 @@ inline JavaScript; with JavaScript off they stay hidden and every check is shown
 Order: failed checks first, then passes whose physics verdict differs, then passes; within each, by
 kind, scene and frame. What a card shows, from the record: its verdict, message, metrics against
 limits (``≥`` for names in :data:`AT_LEAST_PREFIXES`, else ``≤``), pictures, params, sync,
-reproduce command, and from ``details``: ``tolerance_set`` (the tolerance set in force), ``physics``
+reproduce command, and from ``details``: ``diagnosis`` (the known mistake a failure's drawing is, in
+its own line under the message), ``tolerance_set`` (the tolerance set in force), ``physics``
 (a golden's second verdict, on the stored physics state, shown beside the render verdict: the dict of
 ``snapshots.PhysicsVerdict.as_dict()``, or a bool, or a string such as ``"pass"``), and a "chaotic"
 note when ``details["physics"]["chaotic"]`` or ``details["chaotic"]`` is true or the frame is past
@@ -38,11 +39,13 @@ __all__ = ["render_report", "write_report"]
 AT_LEAST_PREFIXES = ("iou", "min_", "smallest_", "coverage")
 
 _LABELS = {"expected": "expected (golden)", "actual": "actual (render)", "difference": "difference",
-           "pybullet_mask": "pyBullet mask", "fury_mask": "FURY mask", "mask_difference": "mask difference"}
+           "pybullet_mask": "pyBullet mask", "fury_mask": "FURY mask", "mask_difference": "mask difference",
+           "outlined": "the sync's drawing, with the outline of where pyBullet has each failing body"}
 # The colours silhouettes.mask_images uses; shown under the picture so it can be read without the code.
 _LEGENDS = {"mask_difference": (("#fff", "both"), ("#f00", "only FURY"), ("#00f", "only pyBullet"),
-                                ("#ff0", "different targets"))}
-_SHOWN_DETAILS = ("tolerance_set", "physics", "chaotic", "chaotic_after")
+                                ("#ff0", "different targets")),
+            "outlined": (("#f0f", "pyBullet's outline"),)}
+_SHOWN_DETAILS = ("tolerance_set", "physics", "chaotic", "chaotic_after", "diagnosis")
 #: At most this many rows of a table in "details" (a pile has hundreds of targets).
 MAX_ROWS = 200
 
@@ -215,6 +218,8 @@ def _card(record: ImageCheck, index: int, results_dir: Path) -> str:
     ]
     if record.message:
         parts.append(f'<pre class="message">{_e(record.message)}</pre>')
+    if record.details.get("diagnosis"):
+        parts.append(f'<p class="diagnosis"><b>diagnosis</b> {_e(record.details["diagnosis"])}</p>')
     if pictures:
         parts.append(f'<div class="pictures">{pictures}</div>')
     parts.append(_metrics(record))
@@ -236,7 +241,7 @@ def render_report(records: Iterable[ImageCheck], results_dir: str | os.PathLike,
     per_kind = ", ".join(f"{k} {sum(r.kind == k for r in ordered)}"
                          + (f" ({n} failed)" if (n := sum(r.kind == k and not r.passed for r in ordered)) else "")
                          for k in kinds)
-    summary = (f'<span class="count">{len(ordered)} image check{"s" if len(ordered) != 1 else ""}</span>, '
+    summary = (f'<span class="count">{len(ordered)} check{"s" if len(ordered) != 1 else ""} with pictures</span>, '
                f'<span class="{"bad" if failed else "good"}">{failed} failed</span>, {len(ordered) - failed} passed'
                + (f' <span class="kinds">· {_e(per_kind)}</span>' if per_kind else ""))
     header = "".join(f"<li>{_e(line)}</li>" for line in header_lines)
@@ -244,7 +249,7 @@ def render_report(records: Iterable[ImageCheck], results_dir: str | os.PathLike,
     filters = "".join(f'<label><input type="checkbox" checked data-group="{g}" value="{_e(v)}"> {_e(label)}</label>'
                       for g, v, label in boxes)
     cards = "\n".join(_card(record, i, results_dir) for i, record in enumerate(ordered, start=1))
-    empty = "" if ordered else '<p class="empty">No image checks were recorded in this run.</p>'
+    empty = "" if ordered else '<p class="empty">No checks with pictures were recorded in this run.</p>'
     return f"""<!doctype html>
 <html lang="en"><head><meta charset="utf-8"><meta name="viewport" content="width=device-width, initial-scale=1">
 <title>{_e(title)}</title><style>{_CSS}</style></head>
@@ -292,6 +297,7 @@ main{padding:16px 24px;display:flex;flex-direction:column;gap:14px}
 .chip.warn{color:var(--warn);border-color:#ffcc80;background:#fff8ec}.chip.param{font-family:ui-monospace,"DejaVu Sans Mono",monospace}
 .message{margin:4px 0 10px;padding:8px 10px;background:#fdf1f1;border-radius:6px;white-space:pre-wrap;word-break:break-word;font:12.5px/1.45 ui-monospace,"DejaVu Sans Mono",monospace}
 .passed .message{background:#f5f7f9}
+.diagnosis{margin:-4px 0 10px;padding:6px 10px;border-left:3px solid var(--warn);background:#fff8ec;font-size:13px}
 .pictures{display:flex;flex-wrap:wrap;gap:10px;margin:6px 0 10px}
 figure{margin:0;cursor:zoom-in;flex:0 1 385px;min-width:240px}figure.zoom{flex-basis:100%;cursor:zoom-out}
 figure img{display:block;width:100%;height:auto;border:1px solid var(--line);border-radius:4px;image-rendering:pixelated;background:#000}
