@@ -25,7 +25,7 @@ class Options:
     repeats: int = 15
     subject: str = "reference"  # the sync the targets judge
     parts: tuple[str, ...] = DEFAULT_PARTS
-    suite: bool = False
+    suite: bool | str = False  # True or "all": every whole run; "checks": all but ./kit test
     suite_repeats: int = 1
     picture_scenes: tuple[str, ...] = pictures.SCENES
     frames: int | None = None  # frames per round of the sync figures (default: by size, syncs.frames_per_round)
@@ -89,7 +89,8 @@ def _tasks(options: Options, results: Results) -> list[Callable[[], None]]:
             tasks.append(lambda n=name, s=script, e=environment: results.apps.append(
                 app_mode.measure(n, s, e, repeats=min(options.repeats, 3))))
     if options.suite:
-        tasks.append(lambda: results.suite.extend(suite.measure(repeats=options.suite_repeats, baseline_repeats=3)))
+        runs = suite.commands(checks_only=options.suite == "checks")
+        tasks.append(lambda: results.suite.extend(suite.measure(repeats=options.suite_repeats, baseline_repeats=3, runs=runs)))
     return tasks
 
 

@@ -95,12 +95,13 @@ def _pictures_table(results: Results) -> list[str]:
 
 
 def _suite_table(results: Results) -> list[str]:
-    lines = ["| run | wall time | ratio | exit |", "|---|---|---|---|"]
+    lines = ["| run | wall time | ratio | exit | checks failed |", "|---|---|---|---|---|"]
     for f in results.suite:
         if f.name == suite.BASELINE:
-            lines.append(f"| **{f.name}** | {_duration(f.seconds)} | 1.00× | |")
+            lines.append(f"| **{f.name}** | {_duration(f.seconds)} | 1.00× | | |")
         else:
-            lines.append(f"| {f.name} | {_duration(f.seconds)} | {_ratio(f.ratio)} | {f.returncode} |")
+            failed = f"{f.failed} of {f.failed + f.passed}" if f.failed is not None and f.passed is not None else ""
+            lines.append(f"| {f.name} | {_duration(f.seconds)} | {_ratio(f.ratio)} | {f.returncode} | {failed} |")
     return lines
 
 

@@ -13,7 +13,9 @@ For the sync under judgement (``reference`` unless ``--sync`` names another), in
 
 And for whole runs (``--suite``): ``pytest conformance`` serial within 90 s, with ``-n 2`` within 60 s,
 and ``./kit test`` within 5 minutes, each exiting 0 (the team's targets for this 2-core machine; on
-another machine they say how it compares).
+another machine they say how it compares); and a wrong sync's full serial verdict within
+:data:`WRONG_OVER_RIGHT` (1.5) times the right one's, failing (exit 1), so a user with a wrong sync
+waits about as long as one with a right sync (issue 16).
 
 Where a target cannot be met by any sync that reads every pose, because the floor itself (pyBullet's
 per-body read) does not meet it, the verdict says so with the floor's figure.
@@ -104,6 +106,9 @@ def evaluate(figures: Sequence[SyncFigure], subject: str, limits: Limits = Limit
     return verdicts
 
 
+#: A wrong sync's full serial run may take at most this many times the reference's.
+WRONG_OVER_RIGHT = 1.5
+
 #: Whole runs and the wall time each should stay within, in seconds.
 SUITE_LIMITS = {"`pytest conformance`": 90.0, "`pytest conformance -n 2`": 60.0, "`./kit test`": 300.0}
 
@@ -118,4 +123,14 @@ def evaluate_suite(figures) -> list[Verdict]:
         measured = f"{figure.seconds:.1f} s" + ("" if figure.returncode == 0 else f", exit {figure.returncode}")
         verdicts.append(Verdict(f"{figure.name} within {limit:g} s, exit 0", measured,
                                 figure.seconds <= limit and figure.returncode == 0))
+    from .suite import RIGHT, WRONG
+
+    by = {f.name: f for f in figures}
+    if RIGHT in by and WRONG in by:
+        right, wrong = by[RIGHT], by[WRONG]
+        ratio = wrong.seconds / right.seconds if right.seconds > 0 else float("inf")
+        counts = f", {wrong.failed} of {wrong.failed + wrong.passed} checks failed" if wrong.failed is not None and wrong.passed is not None else ""
+        verdicts.append(Verdict(f"a wrong sync's full verdict ({WRONG}) within {WRONG_OVER_RIGHT:g}× the right one's, exit 1",
+                                f"{ratio:.2f}× ({wrong.seconds:.0f} s against {right.seconds:.0f} s{counts}, exit {wrong.returncode})",
+                                ratio <= WRONG_OVER_RIGHT and wrong.returncode == 1 and right.returncode == 0))
     return verdicts

@@ -244,16 +244,18 @@ def test_picture_figures_are_ratios_to_a_frame_of_the_scene():
 
 
 def test_whole_runs_are_timed_with_their_exit_status_and_tabled():
-    runs = [("ok", [sys.executable, "-c", "pass"]),
+    runs = [("ok", [sys.executable, "-c", "print('= 2 failed, 7 passed, 1 skipped in 3.2s =')"]),
             ("fails", [sys.executable, "-c", "import sys; print('boom'); sys.exit(3)"])]
     figures = suite.measure(repeats=1, baseline_repeats=1, runs=runs, baseline=lambda: time.sleep(0.01))
     by = {f.name: f for f in figures}
     assert by[suite.BASELINE].ratio == 1.0 and by["ok"].returncode == 0 and by["ok"].seconds > 0
     assert by["fails"].returncode == 3 and "boom" in by["fails"].tail
+    assert (by["ok"].failed, by["ok"].passed) == (2, 7) and by["fails"].failed is None, "counts from pytest's last line"
     text = report.markdown(Results(options=Options(parts=()), machine=_machine(), started="now", suite=figures))
-    assert "**Whole runs**" in text and "| fails |" in text and "| 3 |" in text
+    assert "**Whole runs**" in text and "| fails |" in text and "| 3 |" in text and "| 2 of 9 |" in text
     assert [name for name, _ in suite.commands()] == ["`pytest --collect-only conformance`", "`pytest conformance`",
-                                                      "`pytest conformance -n 2`", "`./kit test`"]
+                                                      "`pytest conformance -n 2`", suite.WRONG, "`./kit test`"]
+    assert [name for name, _ in suite.commands(checks_only=True)][-1] == suite.WRONG
 
 
 def test_whole_runs_pass_their_time_limits_only_in_time_and_with_exit_0():
@@ -267,6 +269,18 @@ def test_whole_runs_pass_their_time_limits_only_in_time_and_with_exit_0():
     assert not verdicts["`pytest conformance -n 2`"].passed  # over 60 s
     assert not verdicts["`./kit test`"].passed and "exit 1" in verdicts["`./kit test`"].measured
     assert len(verdicts) == 3  # collection has no limit
+
+
+def test_a_wrong_syncs_full_run_is_judged_against_the_right_ones():
+    def verdict(right, wrong, wrong_exit=1):
+        figures = [suite.SuiteFigure(suite.RIGHT, command="…", baseline=1.0, seconds=right, failed=0, passed=295),
+                   suite.SuiteFigure(suite.WRONG, command="…", baseline=1.0, seconds=wrong, returncode=wrong_exit,
+                                     failed=97, passed=198)]
+        return [v for v in targets.evaluate_suite(figures) if "wrong sync" in v.target][0]
+
+    assert verdict(100.0, 140.0).passed and "1.40× (140 s against 100 s, 97 of 295 checks failed, exit 1)" in verdict(100.0, 140.0).measured
+    assert not verdict(100.0, 160.0).passed, "over 1.5×"
+    assert not verdict(100.0, 90.0, wrong_exit=0).passed, "a wrong sync that passes is no verdict"
 
 
 def _machine():

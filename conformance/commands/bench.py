@@ -47,9 +47,9 @@ def add_arguments(parser) -> None:
     parser.add_argument("--only", nargs="+", choices=["syncs", "reads", "pictures", "apps"], default=None,
                         help="measure only these parts (default: syncs, reads and pictures; apps: app mode's cost "
                              "per tick against the app's own)")
-    parser.add_argument("--suite", action="store_true",
-                        help="also time whole runs as subprocesses: pytest conformance, serial and with -n 2, "
-                             "and ./kit test (minutes)")
+    parser.add_argument("--suite", nargs="?", const="all", choices=["all", "checks"], default=False,
+                        help="also time whole runs as subprocesses: pytest conformance, serial and with -n 2, serial "
+                             "against a wrong sync, and ./kit test (half an hour); --suite checks: all but ./kit test")
     parser.add_argument("--suite-repeats", type=argparse_type(positive_int, "--suite-repeats", high=100), default=1, help="runs of each whole run; the best counts (default 1)")
     parser.add_argument("--json", type=argparse_type(file_to_write, "--json", suffixes=(".json",)), default=None, metavar="PATH", help="also write every figure as JSON here")
     parser.add_argument("--readme", type=argparse_type(existing_file, "--readme"), default=None, metavar="PATH", help="also put the tables in this markdown file, "
