@@ -108,9 +108,12 @@ def first_diagnosis(spec, scene: str, frames: int, run_events=(), **params):
     ("wrong_syncs:StaticPlacedOnce", "sliding_box", STATIC_MOVED, "before-event"),
     (RotationOnly, "free_fall", (), "rotation-only"),
     (SwappedPoses, "crossing", (), "other-target"),
+    ("wrong_syncs:FirstMultibodyOnly", "pendulum", (), "other-target"),
 ], ids=lambda v: getattr(v, "__name__", None) or (v.split(":")[-1] if isinstance(v, str) else None))
 def test_a_mistake_in_the_catalogue_gets_its_diagnosis(spec, scene, run_events, mistake):
-    assert first_diagnosis(spec, scene, 30, run_events)[1] == mistake
+    # pendulum: three double pendulums, whose links share indices (the scene's own example).
+    params = {"pendulums": 3, "links": 2} if scene == "pendulum" and spec == "wrong_syncs:FirstMultibodyOnly" else {}
+    assert first_diagnosis(spec, scene, 30, run_events, **params)[1] == mistake
 
 
 @pytest.mark.parametrize("spec, scene", [
