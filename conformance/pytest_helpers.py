@@ -111,12 +111,11 @@ def _vertices_message(failures: Sequence[Any], run: Any, sync: str, worst: Any =
     return "\n".join(lines)
 
 
-def _normals_message(failures: Sequence[Any], run: Any, sync: str, found: str | None = None) -> str:
-    """The message of a frame's normals failures, with the known mistake that explains the worst
-    (``found``: made now when not given; only right after the frame was synced can it be made)."""
+def _normals_message(failures: Sequence[Any], run: Any, sync: str) -> str:
+    """The message of a frame's normals failures, with the known mistake that explains the worst (made
+    from the run as it stands: call it at the failing frame, as survey mode's ``note`` does)."""
     worst = max(failures, key=lambda r: r.angle)
-    if found is None:
-        found = diagnosis.diagnose_normals(run, worst)
+    found = diagnosis.diagnose_normals(run, worst)
     return "\n".join([f"{worst.describe()} {_context(run, sync, worst.frame)}", *([found] if found else []),
                       "reproduce: " + reproduce_command(run.scene.name, sync, worst.frame, run.params, run.events)])
 
@@ -226,23 +225,21 @@ class Kit:
             # The figure is the worst in tolerances, and so is its message; the first failure's message
             # stays default mode's own (about the largest error in metres).
             first = _vertices_message(failures, run, sync, drawn=drawn) if self.survey is None else None
-            self._picture(run, failures, first)
+            self._picture(run, failures, first, drawn)
             self._failed("vertices", lambda w=worst: _vertices_message(failures, run, sync, w, drawn),
                          first=(lambda: first) if first is not None else (lambda: _vertices_message(failures, run, sync, drawn=drawn)),
                          value=worst.error, limit=worst.tolerance, unit="m", frame=worst.frame, target=worst.target)
         turned = [r for r in compare.compare_normals(run.drawing, run.frame, self.tolerance) if not r.ok]
         if turned:
             worst = max(turned, key=lambda r: (r.angle / r.tolerance if r.tolerance else r.angle))
-            # Made now: survey mode words its messages after the run moved on.
-            found = diagnosis.diagnose_normals(run, max(turned, key=lambda r: r.angle))
-            self._failed("normals", lambda: _normals_message(turned, run, sync, found), value=worst.angle,
+            self._failed("normals", lambda: _normals_message(turned, run, sync), value=worst.angle,
                          limit=worst.tolerance, unit="rad", frame=worst.frame, target=worst.target)
         seen = self._announced.get(run, 0)
         for frame, actor in run.unannounced[seen:]:
             self._failed("Modified", lambda: _unannounced_message(frame, actor, run, sync), frame=frame, target=actor)
         self._announced[run] = len(run.unannounced)
 
-    def _picture(self, run: Any, failures: Sequence[Any], message: str | None) -> None:
+    def _picture(self, run: Any, failures: Sequence[Any], message: str | None, drawn: dict[str, Any]) -> None:
         """The failing frame's picture for the report, with pyBullet's outline (:mod:`conformance.rendering.misplaced`)."""
         from conformance.rendering import misplaced
 
@@ -250,7 +247,7 @@ class Kit:
         if message is None:  # survey mode: the first failure's words, made only if its picture is kept
             if self._node is None or misplaced.PICTURE in self._node.stash:
                 return
-            message = _vertices_message(failures, run, self.sync, drawn=_drawn(run, [worst]))
+            message = _vertices_message(failures, run, self.sync, drawn=drawn)
         misplaced.note(self._node, run, failures, worst, sync=self.sync, message=message, first=self.survey is not None)
 
     def fail(self, kind: str, message: str, *, exception: type[BaseException] | None = None, **numbers: Any) -> None:
