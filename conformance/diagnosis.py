@@ -9,10 +9,10 @@ pose holds gets no diagnosis: the catalogue names a mistake only when it reprodu
 target whose vertices are right and whose stored normals are not is tried the same way against the
 normals' mistakes (:data:`NORMAL_MISTAKES`), and a change never announced is named as such.
 
-The poses pyBullet had earlier (the previous step, before a teleport or a joint reset) come from
-replaying the run's physics: the scene built again with the same parameters, the same events applied
-at the same frames, stepped without any sync (scenes are deterministic, bit for bit:
-``test_is_deterministic_in_process``). A replay happens only when a failure is reported.
+The poses pyBullet had earlier (the previous step, before a teleport or a joint reset) are the ones
+the run kept as it went (:class:`conformance.runner.Run`'s ``previous`` and ``before_events``): one
+read of every target's pose per frame, where replaying the physics up to each failing frame made a
+wrong sync's survey of a long scene cost a run per failing frame.
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 import pybullet
 
-from conformance import poses, truth
+from conformance import poses
 
 __all__ = ["EULER_ORDERS", "MISTAKES", "NORMAL_MISTAKES", "Drawn", "diagnose", "diagnose_frame", "diagnose_normals",
            "diagnose_problems", "drawn_now", "explain", "explain_frame", "explain_normals", "unannounced"]
@@ -82,43 +82,21 @@ DISTINCT = 2
 
 @dataclass(frozen=True)
 class Drawn:
-    """One failing target's drawn vertices ``(n, 3)`` (world) at ``frame``, and pyBullet's link-frame and
-    centre-of-mass poses of every target then (``now``, ``com``), kept when the failure was found so that
-    its diagnosis can be made later (survey mode reports after the run moved on)."""
+    """One failing target's drawn vertices ``(n, 3)`` (world) at ``frame``, and pyBullet's poses of every
+    target then (:class:`_Physics`), kept when the failure was found so that its diagnosis can be made
+    later (survey mode reports after the run moved on)."""
 
     index: int
     frame: int
     vertices: np.ndarray
-    now: tuple[np.ndarray, np.ndarray]
-    com: tuple[np.ndarray, np.ndarray]
+    physics: "_Physics"
 
 
-def drawn_now(drawing, names, frame: int) -> dict[str, Drawn]:
-    """What the targets named ``names`` are drawn as now, with pyBullet's poses of every target read once."""
-    from conformance import backends
-
-    p = drawing.world.p
-    items = [(u.body, u.link) for u in drawing.targets]
-    com_pos, com_orn = np.empty((len(items), 3)), np.empty((len(items), 4))
-    for i, (body, link) in enumerate(items):
-        if link < 0:
-            pos, orn = pybullet.getBasePositionAndOrientation(body, physicsClientId=p.client)
-        else:
-            pos, orn = pybullet.getLinkState(body, link, computeForwardKinematics=1, physicsClientId=p.client)[:2]
-        com_pos[i], com_orn[i] = pos, orn
-    now = truth.link_frames(p, items)
-    found = {}
-    for i, t in enumerate(drawing.targets):
-        if t.name in names:
-            vertices = np.array(backends.world_vertices(t.actor)[t.start:t.stop], dtype=np.float64)
-            found[t.name] = Drawn(i, frame, vertices, now, (com_pos, com_orn))
-    return found
-
-
-@dataclass
+@dataclass(frozen=True)
 class _Physics:
-    """pyBullet's link-frame poses of every target at the failing frame (``now``), the one before, and
-    just before each event (replayed), and the centre-of-mass poses at the failing frame."""
+    """pyBullet's link-frame poses of every target at the failing frame (``now``), the one before
+    (``previous``, None at frame 0) and just before each event so far (``before_events``), and the
+    centre-of-mass poses at the failing frame (``com``)."""
 
     now: tuple[np.ndarray, np.ndarray]
     previous: tuple[np.ndarray, np.ndarray] | None
@@ -126,35 +104,33 @@ class _Physics:
     com: tuple[np.ndarray, np.ndarray]
 
 
-def _replay(run, drawn: Drawn) -> _Physics:
-    """The earlier poses, by replaying the run's physics; none when the replay does not reach the poses
-    the run had at the failing frame (physics changed by something other than the run's events)."""
-    from conformance.scenes import build
+def _physics(run) -> _Physics:
+    """pyBullet's poses of every target of ``run`` (a :class:`conformance.runner.Run`) now, and the
+    earlier ones the run kept as it went."""
+    p = run.drawing.world.p
+    items = [(u.body, u.link) for u in run.drawing.targets]
+    com_pos, com_orn = np.empty((len(items), 3)), np.empty((len(items), 4))
+    for i, (body, link) in enumerate(items):
+        if link < 0:
+            pos, orn = pybullet.getBasePositionAndOrientation(body, physicsClientId=p.client)
+        else:
+            pos, orn = pybullet.getLinkState(body, link, computeForwardKinematics=1, physicsClientId=p.client)[:2]
+        com_pos[i], com_orn[i] = pos, orn
+    return _Physics(run.poses(), run.previous, list(run.before_events), (com_pos, com_orn))
 
-    frame = drawn.frame
-    items = [(t.body, t.link) for t in run.drawing.targets]
-    by_frame: dict[int, list] = {}
-    for event in run.events:
-        by_frame.setdefault(event.frame, []).append(event)
-    before_events = []
-    previous = None
-    with build(run.scene.name, **dict(run.params)) as scene:
-        for k in range(frame + 1):
-            if k > 0 and k == frame:
-                previous = truth.link_frames(scene.p, items)
-            events = by_frame.get(k, ())
-            if events:
-                before = truth.link_frames(scene.p, items)
-                before_events.extend((e, before) for e in events)
-                for e in events:
-                    e.apply(scene)
-            if k > 0:
-                scene.advance(k - 1)
-        replayed = truth.link_frames(scene.p, items)
-    if not (np.allclose(replayed[0], drawn.now[0], rtol=0, atol=1e-9)
-            and np.allclose(poses.matrices(replayed[1]), poses.matrices(drawn.now[1]), rtol=0, atol=1e-9)):
-        previous, before_events = None, []
-    return _Physics(drawn.now, previous, before_events, drawn.com)
+
+def drawn_now(run, names, frame: int) -> dict[str, Drawn]:
+    """What the targets named ``names`` of ``run`` are drawn as now, with pyBullet's poses read once."""
+    from conformance import backends
+
+    physics = None
+    found = {}
+    for i, t in enumerate(run.drawing.targets):
+        if t.name in names:
+            physics = physics or _physics(run)
+            vertices = np.array(backends.world_vertices(t.actor)[t.start:t.stop], dtype=np.float64)
+            found[t.name] = Drawn(i, frame, vertices, physics)
+    return found
 
 
 #: Euler compositions renderers make of (roll, pitch, yaw): scipy intrinsic order and the angles' order
@@ -212,10 +188,7 @@ def explain(run, drawn: Drawn, tolerance: float) -> tuple[str, str] | None:
     local = run.drawing.local[drawn.index]
     if not len(local) or not np.all(np.isfinite(drawn.vertices)):
         return None
-    try:
-        physics = _replay(run, drawn)
-    except Exception:  # a diagnosis is a courtesy: a replay that cannot be made gives none
-        return None
+    physics = drawn.physics
     true_p, true_r = _pose(physics.now, drawn.index)
     truth_vertices = local @ true_r.T + true_p
     allowance = 2 * tolerance
@@ -240,7 +213,7 @@ def explain_frame(run, results) -> tuple[str, str] | None:
     if not failing:
         return None
     worst = max(failing, key=lambda r: r.error / r.tolerance if r.tolerance else r.error)
-    drawn = drawn_now(run.drawing, {worst.target}, worst.frame)
+    drawn = drawn_now(run, {worst.target}, worst.frame)
     return explain(run, drawn[worst.target], worst.tolerance) if worst.target in drawn else None
 
 
@@ -270,17 +243,13 @@ def explain_normals(run, result) -> tuple[str, str] | None:
     drawn = np.asarray(stored, dtype=np.float64)[t.start:t.stop]
     if drawn.shape != local.shape or not np.all(np.isfinite(drawn)):
         return None
-    now = truth.link_frames(run.drawing.world.p, [(u.body, u.link) for u in run.drawing.targets])
-    r = poses.matrices(now[1][i])
+    r = poses.matrices(run.poses()[1][i])
     unit = local / np.linalg.norm(local, axis=1, keepdims=True)
     drawn = drawn / np.linalg.norm(drawn, axis=1, keepdims=True)
     allowance = 2 * result.tolerance
 
     def candidates():
-        try:
-            previous = _replay(run, Drawn(i, result.frame, drawn, now, now)).previous
-        except Exception:  # a diagnosis is a courtesy: a replay that cannot be made gives none
-            previous = None
+        previous = run.previous if result.frame == run.frame else None
         if previous is not None:
             yield "normals-previous-step", {"frame": result.frame - 1}, poses.matrices(previous[1][i])
         yield "stale-normals", {}, poses.matrices(np.asarray(t.orientation, dtype=np.float64))

@@ -91,7 +91,7 @@ def _largest(failures: Sequence[Any]) -> Any:
 
 def _drawn(run: Any, results: Sequence[Any]) -> dict[str, Any]:
     """What the failing targets ``results`` are drawn as now, for their diagnoses (made later, if at all)."""
-    return diagnosis.drawn_now(run.drawing, {r.target for r in results}, results[0].frame)
+    return diagnosis.drawn_now(run, {r.target for r in results}, results[0].frame)
 
 
 def _vertices_message(failures: Sequence[Any], run: Any, sync: str, worst: Any = None, drawn=None) -> str:

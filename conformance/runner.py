@@ -12,7 +12,7 @@ from collections import defaultdict
 from dataclasses import dataclass, field
 from typing import Any, Iterator, Mapping, Sequence
 
-from conformance import backends
+from conformance import backends, truth
 from conformance.backends.common import Drawing
 from conformance.events import Event
 from conformance.scenes import Scene, build
@@ -39,12 +39,33 @@ class Run:
         #: (frame, actor name) of every sync that changed an actor's data without telling the renderer.
         self.unannounced: list[tuple[int, str]] = []
         self._after: dict[str, tuple[int, bytes]] = {}
+        self._items = [(t.body, t.link) for t in self.drawing.targets]
+        #: pyBullet's link-frame poses of every target (positions, quaternions) when the current frame
+        #: began, before its events and step: the previous step's (None at frame 0). With
+        #: ``before_events``, the earlier poses a diagnosis tries (:mod:`conformance.diagnosis`), kept
+        #: as the run goes because replaying the physics to find them would cost a run per failure.
+        self.previous: tuple[Any, Any] | None = None
+        #: (event, every target's poses just before it) for each event applied so far.
+        self.before_events: list[tuple[Event, tuple[Any, Any]]] = []
+
+    def poses(self) -> tuple[Any, Any]:
+        """pyBullet's link-frame poses of every target now: positions ``(n, 3)``, quaternions ``(n, 4)``."""
+        return truth.link_frames(self.drawing.world.p, self._items)
+
+    def apply_events(self, poses: tuple[Any, Any] | None = None) -> None:
+        """Apply the events of the current frame, noting every target's poses just before them."""
+        events = self._by_frame.get(self.frame, ())
+        if events:
+            before = self.poses() if poses is None else poses
+            for event in events:
+                self.before_events.append((event, before))
+                event.apply(self.scene)
 
     def step(self) -> None:
         """One frame of physics without syncing: events, actions, ``stepSimulation``."""
         self.frame += 1
-        for event in self._by_frame.get(self.frame, ()):
-            event.apply(self.scene)
+        self.previous = self.poses()
+        self.apply_events(self.previous)
         self.scene.advance(self.frame - 1)
 
     def sync(self) -> None:
@@ -86,7 +107,6 @@ def running(scene: str, implementation: SyncImplementation, events: Sequence[Eve
         drawing = backends.build(built)
         syncer = implementation.start(drawing.world)
         run = Run(scene=built, drawing=drawing, syncer=syncer, params=dict(built.params), events=tuple(events))
-        for event in run._by_frame.get(0, ()):
-            event.apply(built)
+        run.apply_events()
         run.sync()
         yield run

@@ -14,6 +14,9 @@ from __future__ import annotations
 __all__ = ["install", "scene_actors"]
 
 KIND = "FURY 0.12 ShowManager"
+#: The size of the app's window under the kit (off-screen): the checks read vertices, not pixels, and
+#: the app's own size (900×768, say) made its renders most of an app's run on the CPU.
+SIZE = (64, 64)
 
 
 class _Source:
@@ -66,6 +69,7 @@ def install(driver) -> None:
     def __init__(self, *args, **kwargs):
         original_init(self, *args, **kwargs)
         self.window.SetOffScreenRendering(1)  # drawn on the kit's display, never mapped
+        self.window.SetSize(*SIZE)
         self._kit_source = _Source(self)
         driver.offer(self._kit_source)
 
