@@ -12,10 +12,11 @@ same message, and the check runs on and fails at its end with every kind it foun
 from __future__ import annotations
 
 import contextlib
+import functools
 import json
 import shlex
 import weakref
-from typing import Any, Iterable, Iterator, Mapping, Sequence
+from typing import Any, Callable, Iterable, Iterator, Mapping, Sequence
 
 import pytest
 
@@ -221,13 +222,15 @@ class Kit:
         failures = [r for r in results if not r.ok]
         if failures:
             worst = max(failures, key=_by_ratio)
-            drawn = _drawn(run, [worst, _largest(failures)])
+            # What the failing targets are drawn as, read only if a message or picture is made (a survey
+            # notes every failing frame and words few of them), always at this frame.
+            drawn = functools.lru_cache(maxsize=None)(lambda: _drawn(run, [worst, _largest(failures)]))
             # The figure is the worst in tolerances, and so is its message; the first failure's message
             # stays default mode's own (about the largest error in metres).
-            first = _vertices_message(failures, run, sync, drawn=drawn) if self.survey is None else None
+            first = _vertices_message(failures, run, sync, drawn=drawn()) if self.survey is None else None
             self._picture(run, failures, first, drawn)
-            self._failed("vertices", lambda w=worst: _vertices_message(failures, run, sync, w, drawn),
-                         first=(lambda: first) if first is not None else (lambda: _vertices_message(failures, run, sync, drawn=drawn)),
+            self._failed("vertices", lambda w=worst: _vertices_message(failures, run, sync, w, drawn()),
+                         first=(lambda: first) if first is not None else (lambda: _vertices_message(failures, run, sync, drawn=drawn())),
                          value=worst.error, limit=worst.tolerance, unit="m", frame=worst.frame, target=worst.target)
         turned = [r for r in compare.compare_normals(run.drawing, run.frame, self.tolerance) if not r.ok]
         if turned:
@@ -239,7 +242,7 @@ class Kit:
             self._failed("Modified", lambda: _unannounced_message(frame, actor, run, sync), frame=frame, target=actor)
         self._announced[run] = len(run.unannounced)
 
-    def _picture(self, run: Any, failures: Sequence[Any], message: str | None, drawn: dict[str, Any]) -> None:
+    def _picture(self, run: Any, failures: Sequence[Any], message: str | None, drawn: Callable[[], dict[str, Any]]) -> None:
         """The failing frame's picture for the report, with pyBullet's outline (:mod:`conformance.rendering.misplaced`)."""
         from conformance.rendering import misplaced
 
@@ -247,7 +250,7 @@ class Kit:
         if message is None:  # survey mode: the first failure's words, made only if its picture is kept
             if self._node is None or misplaced.PICTURE in self._node.stash:
                 return
-            message = _vertices_message(failures, run, self.sync, drawn=drawn)
+            message = _vertices_message(failures, run, self.sync, drawn=drawn())
         misplaced.note(self._node, run, failures, worst, sync=self.sync, message=message, first=self.survey is not None)
 
     def fail(self, kind: str, message: str, *, exception: type[BaseException] | None = None, **numbers: Any) -> None:

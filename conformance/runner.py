@@ -40,32 +40,42 @@ class Run:
         self.unannounced: list[tuple[int, str]] = []
         self._after: dict[str, tuple[int, bytes]] = {}
         self._items = [(t.body, t.link) for t in self.drawing.targets]
-        #: pyBullet's link-frame poses of every target (positions, quaternions) when the current frame
-        #: began, before its events and step: the previous step's (None at frame 0). With
-        #: ``before_events``, the earlier poses a diagnosis tries (:mod:`conformance.diagnosis`), kept
-        #: as the run goes because replaying the physics to find them would cost a run per failure.
-        self.previous: tuple[Any, Any] | None = None
-        #: (event, every target's poses just before it) for each event applied so far.
-        self.before_events: list[tuple[Event, tuple[Any, Any]]] = []
+        # pyBullet's readings of every target when the current frame began, before its events and step
+        # (the previous step's), and just before each event so far: the earlier poses a diagnosis tries
+        # (:mod:`conformance.diagnosis`). Kept as the run goes, because replaying the physics to find
+        # them cost a run per failure; kept as read, because most runs never need them as poses.
+        self._previous: tuple | None = None
+        self._before_events: list[tuple[Event, tuple]] = []
+
+    @property
+    def previous(self) -> tuple[Any, Any] | None:
+        """pyBullet's link-frame poses of every target (positions, quaternions) at the previous step,
+        when the current frame began (None at frame 0)."""
+        return None if self._previous is None else truth.frames_of(self._previous)
+
+    @property
+    def before_events(self) -> list[tuple[Event, tuple[Any, Any]]]:
+        """(event, every target's link-frame poses just before it) for each event applied so far."""
+        return [(event, truth.frames_of(states)) for event, states in self._before_events]
 
     def poses(self) -> tuple[Any, Any]:
         """pyBullet's link-frame poses of every target now: positions ``(n, 3)``, quaternions ``(n, 4)``."""
         return truth.link_frames(self.drawing.world.p, self._items)
 
-    def apply_events(self, poses: tuple[Any, Any] | None = None) -> None:
-        """Apply the events of the current frame, noting every target's poses just before them."""
+    def apply_events(self, states: tuple | None = None) -> None:
+        """Apply the events of the current frame, noting what pyBullet read just before them."""
         events = self._by_frame.get(self.frame, ())
         if events:
-            before = self.poses() if poses is None else poses
+            before = truth.read_states(self.drawing.world.p, self._items) if states is None else states
             for event in events:
-                self.before_events.append((event, before))
+                self._before_events.append((event, before))
                 event.apply(self.scene)
 
     def step(self) -> None:
         """One frame of physics without syncing: events, actions, ``stepSimulation``."""
         self.frame += 1
-        self.previous = self.poses()
-        self.apply_events(self.previous)
+        self._previous = truth.read_states(self.drawing.world.p, self._items)
+        self.apply_events(self._previous)
         self.scene.advance(self.frame - 1)
 
     def sync(self) -> None:

@@ -26,7 +26,7 @@ from scipy.spatial.transform import Rotation
 from conformance import poses
 from conformance.client import BoundClient
 
-__all__ = ["aabb_half_extents", "expected_vertices", "link_frame", "link_frames"]
+__all__ = ["aabb_half_extents", "expected_vertices", "frames_of", "link_frame", "link_frames", "read_states"]
 
 
 def link_frame(p: BoundClient, body: int, link: int) -> tuple[np.ndarray, np.ndarray]:
@@ -46,10 +46,13 @@ def link_frames(p: BoundClient, items: Sequence[tuple[int, int]]) -> tuple[np.nd
     The same arithmetic as :func:`link_frame`, batched: one ``getLinkStates`` per body with links,
     one scipy call for all bases, and pybullet called directly with the client id (the checks
     call this every frame, so the bound client's per-call wrapping would show)."""
+    return frames_of(read_states(p, items))
+
+
+def read_states(p: BoundClient, items: Sequence[tuple[int, int]]) -> tuple:
+    """What :func:`link_frames` reads from pyBullet, as pyBullet returns it: the cheap half, for a
+    caller that keeps poses it may never need (:func:`frames_of` makes them link frames)."""
     client = p.client
-    n = len(items)
-    positions = np.empty((n, 3))
-    orientations = np.empty((n, 4))
     links: dict[int, list[int]] = {}
     bases = []
     for i, (body, link) in enumerate(items):
@@ -57,14 +60,22 @@ def link_frames(p: BoundClient, items: Sequence[tuple[int, int]]) -> tuple[np.nd
             links.setdefault(body, []).append(i)
         else:
             bases.append(i)
-    for body, rows in links.items():
-        states = pybullet.getLinkStates(body, [items[i][1] for i in rows], computeForwardKinematics=1,
-                                        physicsClientId=client)
-        for i, state in zip(rows, states):
+    states = [(rows, pybullet.getLinkStates(body, [items[i][1] for i in rows], computeForwardKinematics=1,
+                                            physicsClientId=client)) for body, rows in links.items()]
+    com = [pybullet.getBasePositionAndOrientation(items[i][0], physicsClientId=client) for i in bases]
+    inertial = [pybullet.getDynamicsInfo(items[i][0], -1, physicsClientId=client)[3:5] for i in bases]
+    return len(items), states, bases, com, inertial
+
+
+def frames_of(states: tuple) -> tuple[np.ndarray, np.ndarray]:
+    """The link-frame poses (positions ``(n, 3)``, quaternions ``(n, 4)``) of :func:`read_states`' reading."""
+    n, links, bases, com, inertial = states
+    positions = np.empty((n, 3))
+    orientations = np.empty((n, 4))
+    for rows, found in links:
+        for i, state in zip(rows, found):
             positions[i], orientations[i] = state[4], state[5]
     if bases:
-        com = [pybullet.getBasePositionAndOrientation(items[i][0], physicsClientId=client) for i in bases]
-        inertial = [pybullet.getDynamicsInfo(items[i][0], -1, physicsClientId=client)[3:5] for i in bases]
         com_rot = Rotation.from_quat([c[1] for c in com])
         frame_rot = com_rot * Rotation.from_quat([l[1] for l in inertial]).inv()
         positions[bases] = np.array([c[0] for c in com]) - frame_rot.apply(np.array([l[0] for l in inertial]))
