@@ -3,10 +3,10 @@
 The integration guide's "Brick Wall Simulation (Single Actor)" and its section "Rendering multiple
 objects by a single actor", for FURY 0.12 (VTK). The ball and the base plate are whole actors, posed
 with a user matrix built from pyBullet's quaternion. The bricks are one ``actor.box`` of 100 boxes,
-24 vertices each, whose points ``utils.vertices_from_actor`` hands out as a writable numpy view.
+8 vertices each (FURY 0.12 shares corners; FURY 2's box has 24), whose points ``utils.vertices_from_actor`` hands out as a writable numpy view.
 
 Rather than turning each range by the rotation since the previous frame (the guide's
-``getDifferenceQuaternion`` recipe, whose rounding adds up), each brick's 24 vertices are captured once
+``getDifferenceQuaternion`` recipe, whose rounding adds up), each brick's 8 vertices are captured once
 in its own link frame and recomputed every frame from pyBullet's pose: ``world = R(orn) @ local + pos``.
 ``utils.update_actor`` then tells VTK the points changed; without it the old bricks stay on screen.
 
@@ -67,9 +67,9 @@ for k in range(nb_rows):
 
 brick_actor = actor.box(centers=brick_centers, directions=np.tile([1.0, 0.0, 0.0], (nb_bricks, 1)),
                         scales=np.tile(brick_size, (nb_bricks, 1)), colors=brick_colors)
-vertices = utils.vertices_from_actor(brick_actor)   # (2400, 3), a view of VTK's points
+vertices = utils.vertices_from_actor(brick_actor)   # (800, 3), a view of VTK's points
 num_vertices = vertices.shape[0]
-sec = num_vertices // nb_bricks                     # 24 vertices a brick
+sec = num_vertices // nb_bricks                     # 8 vertices a brick
 
 # Each brick's vertices in its own link frame, captured once: local = R0^T (v - c0).
 brick_local = np.zeros((nb_bricks, sec, 3))
