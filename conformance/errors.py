@@ -22,6 +22,7 @@ __all__ = [
     "SyncLoadError",
     "SyncProtocolError",
     "SyncRaised",
+    "SyncTimedOut",
 ]
 
 
@@ -66,6 +67,11 @@ class SyncProtocolError(SyncError):
 
 class SyncRaised(SyncError):
     """The sync implementation raised while the kit was running it."""
+
+
+class SyncTimedOut(SyncError):
+    """A call into the sync implementation did not return within the time limit
+    (:mod:`conformance.time_limit`)."""
 
 
 class GoldenError(ConformanceError):

@@ -4,6 +4,8 @@ Options live under one group, each mirrored by an ini setting:
 
 * ``--sync SPEC`` / ``conformance_sync``: the implementation under test, a short name or
   ``module:attribute``; ``$CONFORMANCE_SYNC`` when neither is given; ``reference`` by default.
+* ``--conformance-sync-timeout SECONDS`` / ``conformance_sync_timeout``: the longest one call into the
+  sync may take (default 10 s, 0 for none; :mod:`conformance.time_limit`).
 * ``--conformance-size-rtol``, ``--conformance-position-rtol``, ``--conformance-atol``,
   ``--conformance-normal-angle`` (and ``conformance_size_rtol`` … in the ini file): the tolerances
   of :mod:`conformance.tolerances`.
@@ -49,6 +51,10 @@ def pytest_addoption(parser: pytest.Parser) -> None:
         "guide-joint) or module:attribute. Default: ini conformance_sync, else $CONFORMANCE_SYNC, else reference.",
     )
     parser.addini("conformance_sync", "default for --sync", default=None)
+    group.addoption("--conformance-sync-timeout", dest="conformance_sync_timeout", default=None, metavar="SECONDS",
+                    help="longest one call into the sync may take before its check fails with where it was "
+                    "(default 10; 0: no limit); the kit's own stepping and rendering are not limited")
+    parser.addini("conformance_sync_timeout", "default for --conformance-sync-timeout", default=None)
     for name, help_text in _TOLERANCE_OPTIONS.items():
         # No type=float: conformance.validation reads the text, so a bad number, NaN or inf is refused
         # with the same sentence as in the ini file.
@@ -254,9 +260,15 @@ def pytest_collection_modifyitems(session: pytest.Session, config: pytest.Config
     from conformance.sync import load
 
     try:
-        config.stash[_SYNC_KEY] = load(_sync_spec(config))
+        config.stash[_SYNC_KEY] = _limited(config, load(_sync_spec(config)))
     except SyncError as err:
         raise pytest.UsageError(str(err)) from None
+
+
+def _limited(config: pytest.Config, implementation):
+    """``implementation`` with the time limit per call in force (``--conformance-sync-timeout``)."""
+    seconds = _option(config, "sync_timeout")
+    return implementation if seconds is None else dataclasses.replace(implementation, time_limit=seconds)
 
 
 @pytest.fixture(scope="session")
@@ -267,7 +279,7 @@ def sync_implementation(request: pytest.FixtureRequest):
     except KeyError:  # collected in an unusual way (e.g. a plugin added items late): load now
         from conformance.sync import load
 
-        implementation = load(_sync_spec(request.config))
+        implementation = _limited(request.config, load(_sync_spec(request.config)))
         request.config.stash[_SYNC_KEY] = implementation
         return implementation
 

@@ -25,7 +25,8 @@ import traceback
 from dataclasses import dataclass
 from typing import Any, Callable
 
-from conformance.errors import SyncLoadError, SyncProtocolError, SyncRaised
+from conformance import time_limit as limits
+from conformance.errors import SyncLoadError, SyncProtocolError, SyncRaised, SyncTimedOut
 from conformance.world import World
 
 __all__ = ["ENV_VAR", "SHORT_NAMES", "Syncer", "SyncImplementation", "load", "resolve_spec"]
@@ -78,6 +79,8 @@ class SyncImplementation:
     spec: str
     target: str  # the module:attribute it resolved to
     factory: Callable[[World], Callable[[], None]]
+    #: seconds each call into the implementation may take (None or 0: no limit; :mod:`conformance.time_limit`)
+    time_limit: float | None = limits.DEFAULT
 
     @property
     def summary(self) -> str:
@@ -87,7 +90,10 @@ class SyncImplementation:
     def start(self, world: World) -> "Syncer":
         """Call the factory for ``world``; errors become :class:`~conformance.errors.SyncError`."""
         try:
-            step_fn = self.factory(world)
+            with limits.limited(self.time_limit):
+                step_fn = self.factory(world)
+        except limits.Expired as exc:
+            raise _timed_out(self.spec, self.time_limit, f"while being set up for scene {world.scene!r}", exc) from None
         except Exception as exc:
             raise SyncRaised(
                 f"sync implementation {self.spec!r} raised while being set up for scene {world.scene!r}: "
@@ -100,20 +106,30 @@ class SyncImplementation:
                 "step (see 'The sync protocol' in the README)."
             )
         _check_arity(step_fn, 0, f"the callable returned by sync implementation {self.spec!r}")
-        return Syncer(self.spec, world.scene, step_fn)
+        return Syncer(self.spec, world.scene, step_fn, self.time_limit)
+
+
+def _timed_out(spec: str, seconds: float, when: str, exc: BaseException) -> SyncTimedOut:
+    return SyncTimedOut(
+        f"sync implementation {spec!r} did not return within {seconds:g} s {when}, and was stopped there (the "
+        f"limit of one call: --conformance-sync-timeout or the ini conformance_sync_timeout, 0 for none). "
+        f"It was at:\n{limits.stack(exc)}")
 
 
 class Syncer:
-    """One implementation bound to one scene; calling it syncs one frame."""
+    """One implementation bound to one scene; calling it syncs one frame, within ``time_limit`` seconds."""
 
-    def __init__(self, spec: str, scene: str, step_fn: Callable[[], None]):
-        self.spec, self.scene, self._fn = spec, scene, step_fn
+    def __init__(self, spec: str, scene: str, step_fn: Callable[[], None], time_limit: float | None = None):
+        self.spec, self.scene, self._fn, self.time_limit = spec, scene, step_fn, time_limit
         self.frame = -1
 
     def __call__(self, frame: int) -> None:
         self.frame = frame
         try:
-            self._fn()
+            with limits.limited(self.time_limit):
+                self._fn()
+        except limits.Expired as exc:
+            raise _timed_out(self.spec, self.time_limit, f"on scene {self.scene!r} at step {frame}", exc) from None
         except Exception as exc:
             raise SyncRaised(
                 f"sync implementation {self.spec!r} raised on scene {self.scene!r} at step {frame}: "

@@ -362,7 +362,7 @@ def plugin_option(config, name: str) -> Any:
     label, value = _given(config, name)
     if value is None:
         return None
-    if name in TOLERANCE_OPTIONS:
+    if name in TOLERANCE_OPTIONS or name == "sync_timeout":
         return finite_non_negative(label, value)
     if name == "report":
         return report_path(label, value)

@@ -1,0 +1,28 @@
+"""Syncs that hang, for the time limit's tests (not wrong syncs: the kill rate must not wait on them)."""
+
+from __future__ import annotations
+
+import time
+
+from conformance.implementations.reference import ReferenceSync
+
+#: The scene and the call (1-based) at which :class:`HangsOnFreeFall` hangs.
+SCENE, CALL = "free_fall", 50
+
+
+class HangsOnFreeFall(ReferenceSync):
+    """Right, except that on ``free_fall`` its 50th call sleeps for an hour, swallowing every Exception
+    (as a sync waiting on a lock or a socket might): a time limit must still stop it."""
+
+    def __init__(self, world):
+        super().__init__(world)
+        self.scene, self.calls = world.scene, 0
+
+    def __call__(self):
+        self.calls += 1
+        if self.scene == SCENE and self.calls == CALL:
+            try:
+                time.sleep(3600)
+            except Exception:
+                pass
+        return super().__call__()
