@@ -91,8 +91,8 @@ class Run:
             before[name] = last if last is not None and last[0] == backends.content_time(actor) else backends.content_state(actor)
         self.syncer(self.frame)
         self._after = {name: backends.content_state(a) for name, a in actors.items()}
-        for name, (mtime, content) in self._after.items():
-            if content != before[name][1] and mtime <= before[name][0]:
+        for name, after in self._after.items():
+            if after[1] != before[name][1] and not backends.announced(actors[name], before[name], after):
                 self.unannounced.append((self.frame, name))
         backends.flush(self.drawing)
 

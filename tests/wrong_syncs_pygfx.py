@@ -14,8 +14,8 @@ import numpy as np
 import sync_steps
 from right_syncs_pygfx import PerTargetSync as Baseline  # the correct sync each mistake departs from
 
-__all__ = ["CentreNotUpdated", "EulerRotateXYZ", "Float32Incremental", "ForgetsModified", "InflatedAgainstZFighting",
-           "NormalsNotRotated", "TintsMovingBodies", "WrongVertexRange"]
+__all__ = ["AnnouncesLastRangeOnly", "CentreNotUpdated", "EulerRotateXYZ", "Float32Incremental", "ForgetsModified",
+           "InflatedAgainstZFighting", "NormalsNotRotated", "NormalsUnannounced", "TintsMovingBodies", "WrongVertexRange"]
 
 
 # ---- rotations ---------------------------------------------------------------------------------------
@@ -97,6 +97,32 @@ class ForgetsModified(Baseline):
 
     def finish(self, actors):
         pass
+
+
+class NormalsUnannounced(Baseline):
+    """Wrong: turns the normals with the vertices but announces only ``geometry.positions``: pygfx uploads
+    each buffer on its own, so the normals on screen stay as they were and a turned sphere is lit as
+    before (the kit's vertex and normals read-back sees the buffers, not what was uploaded)."""
+
+    def finish(self, actors):
+        for actor in actors:
+            actor.geometry.positions.update_full()
+
+
+class AnnouncesLastRangeOnly(Baseline):
+    """Wrong: announces one range per shared actor after the loop, with the loop's last target
+    (``update_range(t.start, t.stop - t.start)`` dedented one level): every other body's vertices
+    change in a buffer whose changed chunks pygfx is never told about."""
+
+    def place_shared(self, t, pos, orn):
+        super().place_shared(t, pos, orn)
+        self.last = t
+
+    def finish(self, actors):
+        last = getattr(self, "last", None)
+        for actor in actors:
+            if last is not None and last.actor is actor:
+                self.announce_range(last)
 
 
 # ---- side effects ----------------------------------------------------------------------------------

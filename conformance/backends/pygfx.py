@@ -195,6 +195,31 @@ def content_state(actor) -> tuple[int, bytes]:
     return content_time(actor), b"".join(bytes(memoryview(np.ascontiguousarray(b.data))) for b in _buffers(actor))
 
 
+def announced(actor, before: tuple[int, bytes], after: tuple[int, bytes]) -> bool:
+    """Whether every item of the actor's position and normal buffers that changed from ``before`` to
+    ``after`` (:func:`content_state`) will reach the GPU: pygfx uploads only the chunks that
+    ``update_range``/``update_indices`` marked (or the whole buffer after ``update_full`` or when new), so
+    a changed vertex outside them, or a buffer changed while another was announced, stays old on screen.
+    Read after the sync and before the changes are handed over (:func:`flush`, :func:`hand_over`)."""
+    buffers = _buffers(actor)
+    old, new = before[1], after[1]
+    if len(old) != len(new):  # a buffer replaced by one of another size: new buffers are wholly pending
+        return all(b._chunks_dirt_flag == 2 for b in buffers)
+    offset = 0
+    for buffer in buffers:
+        size = np.asarray(buffer.data).nbytes
+        was, now = old[offset:offset + size], new[offset:offset + size]
+        offset += size
+        if was == now or buffer._chunks_dirt_flag == 2:
+            continue
+        if not buffer._chunks_dirt_flag or not buffer.nitems:
+            return False
+        items = (np.frombuffer(was, np.uint8) != np.frombuffer(now, np.uint8)).reshape(buffer.nitems, -1).any(axis=1)
+        if not buffer._chunk_mask[np.flatnonzero(items) // buffer._chunk_size].all():
+            return False
+    return True
+
+
 def mesh_signature(actor) -> tuple[int, str, str]:
     """Vertex count and digests of the faces and vertex colours: what a sync must leave alone."""
     geometry = actor.geometry

@@ -154,6 +154,13 @@ def content_state(actor) -> tuple[int, bytes]:
     return data.GetMTime(), content
 
 
+def announced(actor, before: tuple[int, bytes], after: tuple[int, bytes]) -> bool:
+    """Whether a change of the actor's data from ``before`` to ``after`` (:func:`content_state`) was
+    announced: VTK's mapper re-uploads all of the geometry (points and normals) when the data's
+    modification time moved, whichever array's ``Modified()`` moved it."""
+    return after[0] > before[0]
+
+
 def mesh_signature(actor) -> tuple[int, str, str]:
     """Vertex count and digests of the cells and vertex colours: what a sync must leave alone."""
     data = actor.GetMapper().GetInput()
