@@ -18,6 +18,7 @@ __all__ = [
     "ImageSizeMismatch",
     "InvalidArgument",
     "SceneError",
+    "SyncCrashed",
     "SyncError",
     "SyncLoadError",
     "SyncProtocolError",
@@ -72,6 +73,11 @@ class SyncRaised(SyncError):
 class SyncTimedOut(SyncError):
     """A call into the sync implementation did not return within the time limit
     (:mod:`conformance.time_limit`)."""
+
+
+class SyncCrashed(SyncError):
+    """The sync implementation crashed the process (a signal, ``os._exit``) on this scene earlier in the
+    run, so a check that would run it there again fails at once (:mod:`conformance.crashes`)."""
 
 
 class GoldenError(ConformanceError):

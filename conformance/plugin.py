@@ -6,6 +6,8 @@ Options live under one group, each mirrored by an ini setting:
   ``module:attribute``; ``$CONFORMANCE_SYNC`` when neither is given; ``reference`` by default.
 * ``--conformance-sync-timeout SECONDS`` / ``conformance_sync_timeout``: the longest one call into the
   sync may take (default 10 s, 0 for none; :mod:`conformance.time_limit`).
+* ``--conformance-isolation auto|process|none`` / ``conformance_isolation``: whether a serial run goes to
+  one worker process, so that a sync that crashes the interpreter fails its checks (:mod:`conformance.crashes`).
 * ``--conformance-size-rtol``, ``--conformance-position-rtol``, ``--conformance-atol``,
   ``--conformance-normal-angle`` (and ``conformance_size_rtol`` … in the ini file): the tolerances
   of :mod:`conformance.tolerances`.
@@ -55,6 +57,11 @@ def pytest_addoption(parser: pytest.Parser) -> None:
                     help="longest one call into the sync may take before its check fails with where it was "
                     "(default 10; 0: no limit); the kit's own stepping and rendering are not limited")
     parser.addini("conformance_sync_timeout", "default for --conformance-sync-timeout", default=None)
+    group.addoption("--conformance-isolation", dest="conformance_isolation", default=None, metavar="MODE",
+                    help="where the checks run, so that a sync that crashes the interpreter fails its checks and "
+                    "the run goes on: auto (default: a serial run of a sync that is not the kit's own runs in one "
+                    "pytest-xdist worker), process (any sync), none (pytest's own process)")
+    parser.addini("conformance_isolation", "default for --conformance-isolation", default=None)
     for name, help_text in _TOLERANCE_OPTIONS.items():
         # No type=float: conformance.validation reads the text, so a bad number, NaN or inf is refused
         # with the same sentence as in the ini file.
@@ -179,19 +186,30 @@ def load_own_scenes(config: pytest.Config) -> None:
         raise pytest.UsageError(str(err)) from None
 
 
+@pytest.hookimpl(wrapper=True)
+def pytest_cmdline_main(config: pytest.Config):
+    """Before pytest-xdist reads ``-n``: a serial run whose sync may crash goes to one worker process."""
+    from conformance import crashes
+
+    crashes.arrange(config, _sync_spec(config), _option(config, "isolation") or "auto")
+    return (yield)
+
+
 def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line("markers", "scene(name): the reference scene a conformance check runs on")
     load_own_scenes(config)
+    _watch_for_crashes(config)
     config.addinivalue_line("markers", "sync: a check that runs the sync implementation under test (added automatically)")
     # pytest-xdist registers it itself; without xdist installed the kit's grouping of a scene's checks
     # would otherwise warn as an unknown mark in every run.
     config.addinivalue_line("markers", "xdist_group(name): checks pytest-xdist runs in one worker (one scene's)")
     app_paths(config), app_ticks(config)  # a missing app or a bad tick count stops the run before collection
     config.stash[_VERDICT_KEY] = defaultdict(lambda: defaultdict(list))
-    if getattr(config.option, "dist", "no") == "load":
-        # -n's default scheduling, with groups: the checks of one scene (marked below) go to one
-        # worker, which steps the scene once for all of them (conformance.shared_run).
-        config.option.dist = "loadgroup"
+    # -n keeps pytest-xdist's default scheduling. Grouping a scene's checks on one worker
+    # ("loadgroup") would spare a second worker stepping the same scene, but xdist 3.8 applies groups
+    # only when --dist loadgroup is on the command line its workers re-read, and its group scheduler
+    # stalls after a worker crashes (conformance.crashes), so the kit no longer asks for it;
+    # --dist loadgroup given by the user still groups by the marks added below.
     config.pluginmanager.register(_Records(config), "conformance-records")
     import os
 
@@ -204,6 +222,46 @@ def pytest_configure(config: pytest.Config) -> None:
         from conformance import image_options
 
         image_options.from_config(config).start_session()
+
+
+def _watch_for_crashes(config: pytest.Config) -> None:
+    """In workers: the crash journal. In pytest-xdist's controller: the crash handler, xdist's restart cap
+    raised to a crash per scene, and the sync loaded once here too, so that a sync that cannot be loaded
+    is the usual one-paragraph usage error rather than a worker's internal error."""
+    from conformance import crashes
+
+    if hasattr(config, "workerinput"):
+        return
+    if getattr(config.option, "dist", "no") == "no" or not getattr(config.option, "tx", None):
+        return
+    from conformance import scenes
+
+    crashes.allow_restarts(config, len(scenes.names()))
+    spec = _sync_spec(config)
+    config.pluginmanager.register(crashes.Controller(config, spec, _RECORD_PROPERTY), "conformance-crashes")
+    from conformance.sync import SHORT_NAMES
+
+    if spec not in SHORT_NAMES:
+        from conformance.errors import SyncError
+        from conformance.sync import load
+
+        try:
+            load(spec)
+        except SyncError as err:
+            raise pytest.UsageError(str(err)) from None
+
+
+def pytest_sessionstart(session: pytest.Session) -> None:
+    if hasattr(session.config, "workerinput"):  # after pytest's own faulthandler set-up, which it replaces
+        from conformance import crashes
+
+        crashes.start_journal(session.config)
+
+
+def pytest_runtest_logstart(nodeid: str, location) -> None:
+    from conformance import crashes
+
+    crashes.noting(nodeid)
 
 
 def pytest_unconfigure(config: pytest.Config) -> None:
@@ -236,6 +294,7 @@ def pytest_report_header(config: pytest.Config) -> list[str]:
     ]
 
 
+@pytest.hookimpl(tryfirst=True)  # before pytest-xdist's worker names the items by their xdist_group
 def pytest_collection_modifyitems(session: pytest.Session, config: pytest.Config, items) -> None:
     """Mark the checks that run the sync under test (``-m sync`` selects them) and load the sync once,
     before any check runs, if any collected check needs it."""
@@ -250,7 +309,7 @@ def pytest_collection_modifyitems(session: pytest.Session, config: pytest.Config
     for item in uses_sync:
         item.add_marker(pytest.mark.sync)
     ordering.fail_fast(items, lambda item: "sync_implementation" in getattr(item, "fixturenames", ()))
-    for item in uses_sync:  # under pytest-xdist a scene's checks share its run on one worker (shared_run)
+    for item in uses_sync:  # under --dist loadgroup a scene's checks share its run on one worker (shared_run)
         marker = item.get_closest_marker("scene")
         if marker is not None:
             item.add_marker(pytest.mark.xdist_group(marker.args[0]))

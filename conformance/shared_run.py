@@ -13,8 +13,8 @@ as before: each watcher sees the same frames, drawn by a sync called the same wa
 A watcher records through a :class:`~conformance.pytest_helpers.Kit` of its own, in survey mode, so
 nothing it finds stops the others; a sync that raises stops the run, and every check that shares it
 fails with the same paragraph. Only watchers whose check is selected for the scene in this session
-run (``-k`` narrows the shared run too); under pytest-xdist the checks of one scene go to one worker
-(the plugin groups them), so no two workers step the same scene.
+run (``-k`` narrows the shared run too). Under pytest-xdist each worker keeps its own shared runs, so
+two workers may step the same scene (``--dist loadgroup`` keeps a scene's checks on one worker).
 """
 
 from __future__ import annotations

@@ -25,6 +25,7 @@ import traceback
 from dataclasses import dataclass
 from typing import Any, Callable
 
+from conformance import crashes
 from conformance import time_limit as limits
 from conformance.errors import SyncLoadError, SyncProtocolError, SyncRaised, SyncTimedOut
 from conformance.world import World
@@ -89,6 +90,8 @@ class SyncImplementation:
 
     def start(self, world: World) -> "Syncer":
         """Call the factory for ``world``; errors become :class:`~conformance.errors.SyncError`."""
+        crashes.check_not_crashed(self.spec, world.scene)
+        crashes.at(world.scene, None)
         try:
             with limits.limited(self.time_limit):
                 step_fn = self.factory(world)
@@ -125,6 +128,7 @@ class Syncer:
 
     def __call__(self, frame: int) -> None:
         self.frame = frame
+        crashes.at(self.scene, frame)
         try:
             with limits.limited(self.time_limit):
                 self._fn()

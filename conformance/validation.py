@@ -366,6 +366,10 @@ def plugin_option(config, name: str) -> Any:
         return finite_non_negative(label, value)
     if name == "report":
         return report_path(label, value)
+    if name == "isolation":
+        from conformance.crashes import CHOICES
+
+        return choice(label, value, CHOICES)
     if name == "image_tolerance":
         return choice(label, value, IMAGE_TOLERANCE_CHOICES)
     if name == "golden_dir":

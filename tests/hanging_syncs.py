@@ -10,9 +10,8 @@ from conformance.implementations.reference import ReferenceSync
 SCENE, CALL = "free_fall", 50
 
 
-class HangsOnFreeFall(ReferenceSync):
-    """Right, except that on ``free_fall`` its 50th call sleeps for an hour, swallowing every Exception
-    (as a sync waiting on a lock or a socket might): a time limit must still stop it."""
+class MisbehavesOnFreeFall(ReferenceSync):
+    """Right, except that on ``free_fall`` its 50th call runs :meth:`misbehave` first."""
 
     def __init__(self, world):
         super().__init__(world)
@@ -21,8 +20,16 @@ class HangsOnFreeFall(ReferenceSync):
     def __call__(self):
         self.calls += 1
         if self.scene == SCENE and self.calls == CALL:
-            try:
-                time.sleep(3600)
-            except Exception:
-                pass
+            self.misbehave()
         return super().__call__()
+
+
+class HangsOnFreeFall(MisbehavesOnFreeFall):
+    """Sleeps for an hour at that call, swallowing every Exception (as a sync waiting on a lock or a
+    socket might): a time limit must still stop it."""
+
+    def misbehave(self):
+        try:
+            time.sleep(3600)
+        except Exception:
+            pass

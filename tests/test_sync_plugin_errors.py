@@ -12,7 +12,10 @@ import pytest
 from conformance import sync
 from conformance.errors import SyncLoadError, SyncProtocolError
 
-RUN = ["--pyargs", "conformance", "-k", "test_vertices_match_poses_every_frame and free_fall", "-p", "no:cacheprovider"]
+# In pytest's own process: these syncs live in pytester's directory, which pytester puts on this process's
+# sys.path only, and these tests read the paragraphs, not where they ran (test_crashes.py runs in workers).
+RUN = ["--pyargs", "conformance", "-k", "test_vertices_match_poses_every_frame and free_fall", "-p", "no:cacheprovider",
+       "--conformance-isolation", "none"]
 
 
 def _write(pytester, name: str, source: str) -> None:

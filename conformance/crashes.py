@@ -1,0 +1,233 @@
+"""A sync that crashes the interpreter fails the checks it crashed, and the run goes on.
+
+A segfault, an ``abort()`` or an ``os._exit`` in the sync under test cannot be caught in the process it
+happens in, so the checks run in a worker process (pytest-xdist's, one worker when the run is serial)
+and the process that started pytest survives to give the verdict. What is guaranteed:
+
+* **Isolation** (``--conformance-isolation`` / ini ``conformance_isolation``): ``auto``, the default, runs
+  a serial run in one worker process when the sync under test is not one of the kit's own (the short
+  names of :data:`conformance.sync.SHORT_NAMES`, which are tested here and do not crash); ``process``
+  does so for any sync; ``none`` runs in pytest's own process, where a crash ends the run as it would
+  without the kit. A run given ``-n`` is already in workers. It is not isolated under ``--pdb`` or
+  ``--trace`` (a debugger needs the test in the terminal's process), nor without pytest-xdist.
+* **A crash is a verdict.** Each worker notes, before every call into the sync, the check, the scene and
+  the step (one ``pwrite`` into a small file: :class:`Journal`), and has :mod:`faulthandler` write the
+  stack to a file when the process dies of a signal. When a worker dies, its check fails with one
+  paragraph: "the process crashed", the signal or exit status, the scene and step, the sync's stack
+  as faulthandler wrote it (Python frames, innermost last; a native library's own frames are not
+  available to Python 3.11), and how to reproduce it. The per-scene verdict, the JSON report and
+  ``report.html`` count it like any failure; pytest-xdist starts a new worker for the other checks.
+* **One crash per scene.** A check that would run a crashed scene with the same sync again fails at once,
+  naming the crash, instead of crashing another worker (:class:`~conformance.errors.SyncCrashed`): so
+  a sync that crashes everywhere costs one worker start per scene, and xdist's limit on restarts is
+  raised to cover every scene.
+* Nothing is left behind: a worker's Xvfb dies with it (:mod:`conformance.display`), and the crash files
+  live in a temporary directory the controller removes at the end.
+"""
+
+from __future__ import annotations
+
+import faulthandler
+import hashlib
+import json
+import os
+import shutil
+import signal
+import tempfile
+from pathlib import Path
+
+from conformance.errors import SyncCrashed
+
+__all__ = ["CHOICES", "Controller", "Journal", "arrange", "check_not_crashed", "noting"]
+
+CHOICES = ("auto", "process", "none")
+_INPUT_KEY = "conformance_crash_dir"
+#: Restarts allowed beyond xdist's own (four per worker): one crash per scene at most (see above).
+_RESTARTS_PER_SCENE = 1
+_RECORD_SIZE = 4096
+
+_journal: "Journal | None" = None
+
+
+def arrange(config, sync_spec: str, mode: str) -> bool:
+    """Before pytest-xdist reads its options (``pytest_cmdline_main``): ask for one worker when the run
+    is serial and ``mode`` says to isolate it. Returns whether the run will be in workers."""
+    from conformance.sync import SHORT_NAMES
+
+    if hasattr(config, "workerinput") or not config.pluginmanager.hasplugin("xdist"):
+        return False
+    if config.option.numprocesses is not None:  # -n given (0 included): the user chose
+        return bool(config.option.numprocesses)
+    if (mode == "none" or (mode == "auto" and sync_spec in SHORT_NAMES) or config.option.collectonly
+            or config.getoption("usepdb", False) or config.getoption("trace", False)):
+        return False
+    config.option.numprocesses = 1
+    return True
+
+
+def allow_restarts(config, scenes: int) -> None:
+    """Raise xdist's cap on replaced workers (4 per worker) by one per scene, unless the user set it."""
+    if config.option.maxworkerrestart is None:
+        workers = config.option.numprocesses if isinstance(config.option.numprocesses, int) else os.cpu_count() or 1
+        config.option.maxworkerrestart = str(4 * workers + _RESTARTS_PER_SCENE * scenes)
+
+
+# -- in a worker ------------------------------------------------------------------------------------
+
+class Journal:
+    """Where this worker is: the check, the sync's scene and step, rewritten in place before each call
+    into the sync, so that it is on disk (in the page cache) whatever kills the process next."""
+
+    def __init__(self, directory: Path, worker: str):
+        self.directory = directory
+        self._fd = os.open(directory / f"{worker}.where", os.O_RDWR | os.O_CREAT | os.O_TRUNC, 0o600)
+        self._stack = open(directory / f"{worker}.stack", "w")  # noqa: SIM115 - open for the process's life
+        faulthandler.enable(file=self._stack, all_threads=False)
+        self.nodeid = ""
+
+    def note(self, **where) -> None:
+        data = json.dumps({"nodeid": self.nodeid, **where}).encode("utf-8")[:_RECORD_SIZE - 1]
+        os.pwrite(self._fd, data.ljust(_RECORD_SIZE, b" "), 0)
+
+    def crashed(self, spec: str, scene: str) -> dict | None:
+        path = _crash_file(self.directory, spec, scene)
+        return json.loads(path.read_text()) if path.exists() else None
+
+
+def start_journal(config) -> None:
+    """In a worker given a crash directory by the controller: keep the journal from now on."""
+    global _journal
+    directory = getattr(config, "workerinput", {}).get(_INPUT_KEY)
+    if directory:
+        _journal = Journal(Path(directory), config.workerinput["workerid"])
+
+
+def noting(nodeid: str) -> None:
+    """The check that starts now (``pytest_runtest_logstart``)."""
+    if _journal is not None:
+        _journal.nodeid = nodeid
+        _journal.note(scene=None, step=None)
+
+
+def at(scene: str, step: int | None) -> None:
+    """The sync is about to be called on ``scene`` at ``step`` (``None``: its factory)."""
+    if _journal is not None:
+        _journal.note(scene=scene, step=step)
+
+
+def check_not_crashed(spec: str, scene: str) -> None:
+    """Raise :class:`SyncCrashed` when ``spec`` already crashed a worker on ``scene`` in this run."""
+    crash = _journal.crashed(spec, scene) if _journal is not None else None
+    if crash is not None:
+        raise SyncCrashed(
+            f"sync implementation {spec!r} crashed the process on scene {scene!r} {_when(crash['step'])} in "
+            f"{crash['nodeid']} ({crash['how']}); this check would run the scene with it again, so it fails "
+            "without running (see that check's failure for the stack).")
+
+
+def _when(step) -> str:
+    return "while being set up" if step is None else f"at step {step}"
+
+
+# -- in the controller ------------------------------------------------------------------------------
+
+class Controller:
+    """The pytest-xdist controller's side: a crash directory for the workers, and a crashed worker's
+    check turned into the kit's failure paragraph and record."""
+
+    def __init__(self, config, sync_spec: str, record_property: str):
+        self.config, self.sync_spec, self.record_property = config, sync_spec, record_property
+        self.directory = Path(tempfile.mkdtemp(prefix="conformance-crashes-"))
+        (self.directory / "crashed").mkdir()
+
+    def pytest_configure_node(self, node) -> None:
+        node.workerinput[_INPUT_KEY] = str(self.directory)
+
+    def pytest_handlecrashitem(self, crashitem: str, report, sched) -> None:
+        worker = report.node.gateway.id
+        where = self._read_where(worker, crashitem)
+        how = _how_it_died(report.node)
+        stack = _read(self.directory / f"{worker}.stack")
+        scene, step = where.get("scene"), where.get("step")
+        if scene is not None:
+            from conformance.files import write_atomically
+
+            write_atomically(_crash_file(self.directory, self.sync_spec, scene), json.dumps(
+                {"nodeid": crashitem, "step": step, "how": how}).encode("utf-8"))
+        place = (f"while sync implementation {self.sync_spec!r} ran on scene {scene!r} {_when(step)}" if scene
+                 else "outside any call into the sync (the kit's own work, or the sync's module)")
+        message = (f"the process crashed ({how}) {place}. The run went on in a new process; this scene's other "
+                   "checks with this sync fail without running it again.\n"
+                   f"Where it was (faulthandler, innermost call last):\n{_stack_lines(stack)}\n"
+                   f"reproduce (in one process): pytest --pyargs conformance --sync {self.sync_spec} "
+                   f"--conformance-isolation none -k '{_test_words(crashitem)}'")
+        report.longrepr = message
+        report.when = "call"
+        report.location = (report.location[0], None, crashitem.split("::", 1)[-1])  # the check's name as its heading
+        report.user_properties.append((self.record_property, {
+            "nodeid": crashitem, "check": _check_name(crashitem), "scene": scene, "when": "call",
+            "outcome": "failed", "verdict": "failed", "worst": None,
+            "kinds": {"crashed": {"value": None, "limit": None, "unit": "", "ratio": float("inf"), "at_least": False,
+                                  "frame": step, "target": None, "message": message.splitlines()[0],
+                                  "failures": 1}},
+            "message": message.splitlines()[0], "diagnosis": ""}))
+
+    def _read_where(self, worker: str, crashitem: str) -> dict:
+        try:
+            where = json.loads(_read(self.directory / f"{worker}.where").strip() or "{}")
+        except ValueError:
+            return {}
+        return where if where.get("nodeid") == crashitem else {}
+
+    def pytest_unconfigure(self, config) -> None:
+        shutil.rmtree(self.directory, ignore_errors=True)
+
+
+def _crash_file(directory: Path, spec: str, scene: str) -> Path:
+    """Where a crash of ``spec`` on ``scene`` is kept: per sync, since a check may also run the kit's own."""
+    return directory / "crashed" / hashlib.sha1(f"{spec}\0{scene}".encode()).hexdigest()
+
+
+def _read(path: Path) -> str:
+    try:
+        return path.read_text(errors="replace")
+    except OSError:
+        return ""
+
+
+def _how_it_died(node) -> str:
+    """The worker's signal or exit status, from the process pytest-xdist started."""
+    popen = getattr(getattr(node.gateway, "_io", None), "popen", None)
+    try:
+        code = popen.wait(timeout=5) if popen is not None else None
+    except Exception:  # still running, or not a local process: say what is known
+        code = None
+    if code is None:
+        return "the worker process went away"
+    if code < 0:
+        try:
+            return f"killed by {signal.Signals(-code).name}"
+        except ValueError:
+            return f"killed by signal {-code}"
+    return f"exit status {code}, without a Python error: os._exit() or a native exit()"
+
+
+def _stack_lines(stack: str) -> str:
+    """faulthandler's dump of the crashing thread, innermost call last, without pytest's and xdist's frames."""
+    lines = [line.strip() for line in stack.splitlines() if line.strip().startswith("File ")]
+    ours = [line for line in lines if "/_pytest/" not in line and "/pluggy/" not in line
+            and "/xdist/" not in line and "/execnet/" not in line and '"<string>"' not in line]
+    ours.reverse()  # faulthandler prints the innermost call first
+    header = next((line.strip() for line in stack.splitlines() if line.startswith("Fatal Python error")), "")
+    body = "\n".join(f"  {line}" for line in ours[-12:])
+    return (header + "\n" if header else "") + (body or "  (no stack: the process ended without a fatal signal)")
+
+
+def _check_name(nodeid: str) -> str:
+    return nodeid.split("::")[-1].split("[")[0]
+
+
+def _test_words(nodeid: str) -> str:
+    name = nodeid.split("::")[-1]
+    check, _, params = name.partition("[")
+    return " and ".join([check, *[p for p in params.rstrip("]").split("-") if p.isidentifier()]])

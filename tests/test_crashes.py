@@ -1,0 +1,102 @@
+"""A sync that kills the interpreter fails the checks it crashed, and the run completes the others,
+serially too: :mod:`conformance.crashes` (issue: syncs that hang or crash)."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from conformance import crashes
+
+from crashing_syncs import CALL, SCENE
+
+CHECKS = (f"(test_vertices_match_poses_every_frame or test_sync_keeps_the_mesh or test_golden_render) "
+          f"and ({SCENE} or sliding_box)")
+SUBSET = ["--pyargs", "conformance", "-p", "no:cacheprovider", "--hypothesis-profile", "default", "-k", CHECKS]
+
+
+def _xvfb() -> set[int]:
+    """Xvfb servers alive (a zombie has died already; whoever inherits it reaps it)."""
+    rows = subprocess.run(["ps", "-C", "Xvfb", "-o", "pid=,stat="], capture_output=True, text=True).stdout.split("\n")
+    return {int(row.split()[0]) for row in rows if row.strip() and not row.split()[1].startswith("Z")}
+
+
+@pytest.fixture
+def run(pytester, monkeypatch):
+    """Run the subset in a fresh pytest process with ``sync``; the result, its JSON records and text."""
+    tests = str(Path(__file__).resolve().parent)  # where the run's processes find crashing_syncs
+    monkeypatch.setenv("PYTHONPATH", os.pathsep.join(filter(None, [tests, os.environ.get("PYTHONPATH")])))
+
+    def running(sync, *args):
+        report = pytester.path / "report.json"
+        before = _xvfb()
+        result = pytester.runpytest_subprocess(*SUBSET, "--sync", sync, "--conformance-report", str(report), *args)
+        left = _xvfb() - before
+        assert not left, f"Xvfb {sorted(left)} left running after the run, but should have died with its worker"
+        records = json.loads(report.read_text())["records"] if report.exists() else []
+        return result, records, result.stdout.str()
+    return running
+
+
+def _outcomes(records) -> dict:
+    return {row["nodeid"].split("::")[-1]: row["outcome"] for row in records}
+
+
+@pytest.mark.parametrize("workers", [[], ["-n", "2"]], ids=["serial", "xdist"])
+def test_a_segfault_fails_its_check_with_where_it_was_and_the_run_goes_on(run, workers):
+    result, records, text = run("crashing_syncs:SegfaultsOnFreeFall", *workers)
+    assert result.ret == pytest.ExitCode.TESTS_FAILED, text
+    assert (f"the process crashed (killed by SIGSEGV) while sync implementation 'crashing_syncs:SegfaultsOnFreeFall' "
+            f"ran on scene '{SCENE}' at step {CALL - 1}") in text, text
+    assert "Fatal Python error: Segmentation fault" in text and "crashing_syncs.py" in text, text
+    assert "reproduce (in one process): pytest --pyargs conformance --sync crashing_syncs:SegfaultsOnFreeFall" in text
+    outcomes = _outcomes(records)
+    # free_fall's golden render runs (first) to its golden frames, before the 50th call: it passes
+    assert len(outcomes) == 6 and all(outcome == ("failed" if SCENE in name and "golden" not in name else "passed")
+                                      for name, outcome in outcomes.items()), outcomes
+    crashed = [row for row in records if "crashed" in row["kinds"]]
+    assert len(crashed) == 1 and crashed[0]["scene"] == SCENE and crashed[0]["kinds"]["crashed"]["frame"] == CALL - 1
+    # the scene's other checks do not crash more workers: they fail at once, naming the crash
+    assert "this check would run the scene with it again, so it fails without running" in text, text
+    assert f"FAIL  {SCENE}" in text and "PASS  sliding_box" in text, text
+    page = text.split("conformance: report (image checks, failing vertex checks): ")[1].split()[0]
+    assert Path(page).is_file(), f"{page}, but the run's report.html was not written"
+
+
+@pytest.mark.parametrize("sync, how", [("AbortsOnFreeFall", "killed by SIGABRT"),
+                                       ("ExitsOnFreeFall", "exit status 3, without a Python error")])
+def test_an_abort_or_an_exit_is_a_verdict_too(run, sync, how):
+    result, records, text = run(f"crashing_syncs:{sync}")
+    assert result.ret == pytest.ExitCode.TESTS_FAILED, text
+    assert f"the process crashed ({how}" in text and f"scene '{SCENE}' at step {CALL - 1}" in text, text
+    assert _outcomes(records)["test_vertices_match_poses_every_frame[sliding_box]"] == "passed", text
+
+
+def test_a_right_sync_of_the_users_is_isolated_and_passes(run):
+    result, records, text = run("conformance.implementations.reference:ReferenceSync")
+    assert result.ret == pytest.ExitCode.OK, text
+    assert "1 worker" in text or "bringing up nodes" in text, f"not run in a worker process:\n{text}"
+    assert set(_outcomes(records).values()) == {"passed"}
+
+
+def test_without_isolation_a_crash_ends_the_run_as_it_would_without_the_kit(run):
+    result, records, text = run("crashing_syncs:SegfaultsOnFreeFall", "--conformance-isolation", "none")
+    assert result.ret not in (pytest.ExitCode.OK, pytest.ExitCode.TESTS_FAILED), text  # killed: no verdict
+    assert records == []
+
+
+def test_an_isolation_that_is_not_a_choice_is_refused(pytester):
+    result = pytester.runpytest(*SUBSET, "--conformance-isolation", "threads")
+    assert result.ret == pytest.ExitCode.USAGE_ERROR
+    assert "threads" in result.stderr.str() and "auto" in result.stderr.str()
+
+
+def test_the_crashed_checks_words_select_it_again():
+    assert crashes._test_words("test_vertices.py::test_sync_keeps_the_mesh[free_fall]") == \
+        "test_sync_keeps_the_mesh and free_fall"
+    assert crashes._test_words("test_scenes.py::test_draws_its_collision_geometry[first-chain]") == \
+        "test_draws_its_collision_geometry and first and chain"
