@@ -22,7 +22,8 @@ import numpy as np
 
 from conformance import truth
 
-__all__ = ["PhysicsDifference", "capture", "compare", "first_divergence", "nudged", "restore"]
+__all__ = ["FLOAT_NOISE", "FloatNoise", "PhysicsDifference", "capture", "compare", "first_divergence", "float_noise",
+           "nudged", "restore"]
 
 #: Physics verdict: a live target farther than this from its stored link-frame pose is a difference.
 #: On one machine pyBullet is bit-identical run to run (``test_scenes`` proves it), so any figure
@@ -30,6 +31,16 @@ __all__ = ["PhysicsDifference", "capture", "compare", "first_divergence", "nudge
 #: noise from another platform quiet while a real change in physics (a step, a parameter) shows.
 POSITION_TOLERANCE = 1e-6
 ANGLE_TOLERANCE = 1e-5
+
+#: Regeneration: a fresh state whose every float is within this of the stored state's (metres, m/s,
+#: rad/s, quaternion components alike) differs by float noise only, and the stored golden is kept.
+#: pyBullet computes in float64, bit-identical run to run on one machine; another CPU running the same
+#: build may round a few operations differently (its libm's sin, cos, sqrt or pow off by an ulp, a·b+c
+#: fused into one FMA or not), which moves the last bits: weighted's 0.041971097911914286 came back as
+#: 0.04197109791191429, 7e-18 apart. A thousandth of the physics verdict's 1 µm (and the vertex
+#: tolerance's 1e-9 m floor, ``tolerances.Tolerance.atol``) is a million ulps of a coordinate of a metre,
+#: yet moves no verdict by more than 0.1 % of its tolerance: a kept golden judges as a rewritten one would.
+FLOAT_NOISE = POSITION_TOLERANCE / 1000
 
 
 def capture(scene) -> dict[str, Any]:
@@ -135,3 +146,41 @@ def first_divergence(scene_name: str, steps: int, distance: float = 1e-9) -> int
             if not compare(capture(moved), capture(plain)).ok:
                 return step + 1
     return None
+
+
+@dataclass(frozen=True)
+class FloatNoise:
+    """The largest difference between the floats of two states that differ in nothing else."""
+
+    largest: float
+    where: str  # the float's path in the state, e.g. "bodies[1].position[0]"
+
+    @property
+    def is_noise(self) -> bool:
+        return self.largest <= FLOAT_NOISE
+
+    def describe(self) -> str:
+        return f"largest difference {self.largest:.3g} at {self.where}, bound {FLOAT_NOISE:g}"
+
+
+def float_noise(new: Any, old: Any) -> FloatNoise | None:
+    """How far apart the floats of two states are (as JSON holds them: lists, not tuples), or None
+    when they differ in anything else: other bodies, joints, targets, names, ids, or a float where
+    the other has none. Equal floats of another sign of zero differ by 0 but still differ in bytes."""
+    found = [FloatNoise(0.0, "")]
+
+    def walk(a: Any, b: Any, where: str) -> bool:
+        if type(a) is float and type(b) is float:
+            if a != a or b != b:  # nan: the same only when both are
+                return a != a and b != b
+            difference = 0.0 if a == b else abs(a - b)  # inf - inf is nan, but equal infinities are the same
+            if difference > found[0].largest:
+                found[0] = FloatNoise(difference, where)
+            return True
+        if isinstance(a, dict) and isinstance(b, dict):
+            return a.keys() == b.keys() and all(walk(a[k], b[k], f"{where}.{k}" if where else k) for k in sorted(a))
+        if isinstance(a, list) and isinstance(b, list):
+            return len(a) == len(b) and all(walk(x, y, f"{where}[{i}]") for i, (x, y) in enumerate(zip(a, b)))
+        return type(a) is type(b) and a == b
+
+    return found[0] if walk(new, old, "") else None

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import json
 import os
+import re
 import subprocess
 import sys
 
@@ -77,6 +79,132 @@ def test_regen_failing_remakes_a_wrong_golden_and_says_by_how_much(made, capsys,
     assert "free_fall frame 120: changed: 200 pixels differ" in out, out
     assert "frame 0: " not in out and "frame 60: " not in out  # the passing ones were left alone
     assert png.read_bytes() == golden.paths(made, SCENE, 120)[0].read_bytes()
+
+
+def _bumped(value, by):
+    """Every float of a state moved by ``by`` (ids, names and the shape kept): another CPU's last bits."""
+    if type(value) is float:
+        return by(value)
+    if isinstance(value, list):
+        return [_bumped(v, by) for v in value]
+    if isinstance(value, dict):
+        return {k: _bumped(v, by) for k, v in value.items()}
+    return value
+
+
+def _one_ulp(x):
+    return float(np.nextafter(x, np.inf))
+
+
+@pytest.fixture
+def copy(made, tmp_path):
+    import shutil
+
+    shutil.copytree(made, tmp_path / "copy")
+    return tmp_path / "copy"
+
+
+def _regen_from(monkeypatch, directory, alter):
+    """``regen`` of ``directory`` from goldens made as usual, each ``(frame, image, manifest)`` passed
+    through ``alter`` first: another machine's run, made here."""
+    from conformance.rendering import snapshots
+
+    real = snapshots.make
+    monkeypatch.setattr(snapshots, "make", lambda name: [alter(*made) for made in real(name)])
+    assert cli.main(["regen", SCENE, "--golden-dir", str(directory)]) == 0
+
+
+def _noisy(frame, image, manifest, by=_one_ulp):
+    return frame, image, {**manifest, "state": _bumped(manifest["state"], by)}
+
+
+@pytest.mark.parametrize("by", [_one_ulp, lambda x: x * (1 + 1e-15)], ids=["nextafter", "times-1+1e-15"])
+def test_regen_keeps_goldens_whose_state_differs_only_by_float_noise(copy, monkeypatch, capsys, by):
+    """A state whose every float moved in its last bits, and the same pictures: no file is touched,
+    and each golden says it was kept, by how much and within what bound."""
+    before = _files(copy)
+    manifest = golden.paths(copy, SCENE, 60)[1]
+    noisy = _noisy(60, None, json.loads(manifest.read_text()), by)[2]
+    assert golden.encode_manifest(noisy) != manifest.read_bytes()  # writing it would change bytes
+    _regen_from(monkeypatch, copy, lambda frame, image, made: _noisy(frame, image, made, by))
+    assert _files(copy) == before  # same bytes and mtimes: not rewritten
+    out = capsys.readouterr().out
+    assert re.search(r"free_fall frame 60: kept, not rewritten: same pixels, and the state differs only by float "
+                     r"noise \(largest difference [0-9.e-]+ at \w+\[\d+\]\.\w+\[\d\], bound 1e-09\)", out), out
+    assert "0 new, 0 changed, 0 unchanged, 3 kept with float noise" in out, out
+
+
+@pytest.mark.parametrize("factor, status", [(0.5, "kept"), (2.0, "changed")])
+def test_a_state_change_beyond_the_float_noise_bound_is_written(copy, monkeypatch, capsys, factor, status):
+    """One target moved by half the bound is kept; by twice the bound, its manifest is written and
+    the physics difference reported (the picture is the same)."""
+    from conformance import state
+
+    def moved(frame, image, made):
+        made = json.loads(json.dumps(made))
+        if frame == 60:
+            made["state"]["targets"][0]["position"][2] += factor * state.FLOAT_NOISE
+        return frame, image, made
+
+    before = _files(copy)
+    _regen_from(monkeypatch, copy, moved)
+    out = capsys.readouterr().out
+    assert f"free_fall frame 60: {status}" in out and "frame 0: unchanged" in out, out
+    manifest = golden.paths(copy, SCENE, 60)[1]
+    assert (_files(copy) == before) == (status == "kept")
+    if status == "changed":
+        assert ("pixels identical; physics: largest difference at 'body': 2e-09 m" in out
+                and "; state beyond float noise: largest difference 2e-09 at targets[0].position[2], bound 1e-09" in out), out
+        stored = json.loads(manifest.read_text())["state"]["targets"][0]["position"][2]
+        assert stored == json.loads(before[manifest.relative_to(copy)][0])["state"]["targets"][0]["position"][2] + 2e-9
+
+
+def test_a_changed_picture_is_written_even_when_the_state_is_only_noise(copy, monkeypatch, capsys):
+    def repainted(frame, image, made):
+        if frame == 120:
+            image = image.copy()
+            image[0, 0] = 255 - image[0, 0]
+        return _noisy(frame, image, made)
+
+    before = _files(copy)
+    _regen_from(monkeypatch, copy, repainted)
+    out = capsys.readouterr().out
+    assert "free_fall frame 120: changed: 1 pixels differ" in out and "frame 60: kept, not rewritten: " in out, out
+    after = _files(copy)
+    for path in golden.paths(copy, SCENE, 120):  # both files: the picture and its state, as made
+        assert after[path.relative_to(copy)][0] != before[path.relative_to(copy)][0]
+    assert {k: v for k, v in after.items() if "0120" not in str(k)} == {k: v for k, v in before.items() if "0120" not in str(k)}
+
+
+@pytest.mark.parametrize("key, value", [("versions", {"pybullet": "9.9.9"}), ("renderer", {"backend": "other"}),
+                                        ("sync", "someone_else"), ("camera", {"view_angle": 31.0})])
+def test_any_other_manifest_difference_is_written_with_the_noise(copy, monkeypatch, capsys, key, value):
+    """Float noise keeps a golden only when it is the sole difference: another version, renderer,
+    sync or camera in the manifest is written as before (with the noisy state)."""
+    def other(frame, image, made):
+        frame, image, made = _noisy(frame, image, made)
+        return frame, image, {**made, key: value}
+
+    _regen_from(monkeypatch, copy, other)
+    out = capsys.readouterr().out
+    assert "0 new, 3 changed, 0 unchanged, 0 kept" in out, out
+    assert json.loads(golden.paths(copy, SCENE, 0)[1].read_text())[key] == value
+
+
+def test_float_noise_is_the_largest_float_difference_of_states_alike_in_all_else():
+    from conformance import state
+
+    old = {"bodies": [{"body": 1, "joints": [], "position": [0.25, -0.0, 3.0]}], "targets": [{"name": "box", "position": [1.0]}]}
+    assert state.float_noise(old, old) == state.FloatNoise(0.0, "")
+    noise = state.float_noise(_bumped(old, lambda x: x + 1e-12 if x == 3.0 else x), old)
+    assert noise.where == "bodies[0].position[2]" and noise.largest == pytest.approx(1e-12) and noise.is_noise
+    assert not state.float_noise(_bumped(old, lambda x: x + 2 * state.FLOAT_NOISE), old).is_noise
+    assert state.float_noise(_bumped(old, abs), old).largest == 0.0  # -0.0 and 0.0: other bytes, no distance
+    for other in ({**old, "targets": []}, {**old, "targets": [{"name": "lid", "position": [1.0]}]},
+                  {**old, "bodies": [{"body": 2, "joints": [], "position": [0.25, -0.0, 3.0]}]},
+                  {**old, "bodies": [{"body": 1, "joints": [], "position": [0.25, 0, 3.0]}]},
+                  {**old, "bodies": [{"body": 1, "joints": [], "position": [0.25, float("nan"), 3.0]}]}):
+        assert state.float_noise(other, old) is None, other  # not float noise: something else changed
 
 
 def test_regen_of_an_unknown_scene_writes_nothing(tmp_path, capsys):

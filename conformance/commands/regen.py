@@ -1,4 +1,5 @@
-"""``regen [SCENE…] [--missing | --failing]``: make golden snapshots anew and say what changed."""
+"""``regen [SCENE…] [--missing | --failing]``: make golden snapshots anew and say what changed: per
+golden new, changed (both written), unchanged, or kept (only float noise in its state differed)."""
 
 from __future__ import annotations
 
@@ -29,13 +30,14 @@ def run(args, extra) -> int:
     given = validation.directory_to_write("--golden-dir", args.golden_dir) if args.golden_dir is not None else None
     directories = {name: given if given is not None else own_scenes.golden_dir(name) for name in names}
     mode = "missing" if args.missing else "failing" if args.failing else "all"
-    counts = {"new": 0, "changed": 0, "unchanged": 0}
+    counts = {"new": 0, "changed": 0, "unchanged": 0, "kept": 0}
     with virtual_display():
         for name in progress(names, total=len(names), what="goldens"):  # a bar on a terminal only
             for change in snapshots.regenerate(name, directories[name], mode=mode):
                 counts[change.status] += 1
                 print(change.describe())
     where = ", ".join(str(d) for d in dict.fromkeys(directories.values()))
-    print(f"goldens in {where}: {counts['new']} new, {counts['changed']} changed, {counts['unchanged']} unchanged"
+    print(f"goldens in {where}: {counts['new']} new, {counts['changed']} changed, {counts['unchanged']} unchanged, "
+          f"{counts['kept']} kept with float noise"
           + ("" if mode == "all" else f" (only {mode} ones were made)"))
     return 0

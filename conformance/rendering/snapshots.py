@@ -11,7 +11,8 @@
 * :func:`check_physics` (the *physics* verdict) compares a live run's state at each golden frame
   with the stored one: a difference there is pyBullet or the platform, not rendering;
 * :func:`regenerate` writes goldens anew (atomically, unchanged bytes untouched) and says what
-  changed and by how much.
+  changed and by how much; a golden whose picture is the same and whose state differs only by float
+  noise (:data:`conformance.state.FLOAT_NOISE`) is kept as it is, so another CPU regenerates no noise.
 """
 
 from __future__ import annotations
@@ -29,7 +30,8 @@ from conformance.errors import GoldenError
 from conformance.rendering import golden as storage
 from conformance.rendering.records import ImageCheck
 
-__all__ = ["Change", "check_physics", "check_render", "make", "regenerate", "same_renderer", "tolerance_for"]
+__all__ = ["Change", "check_physics", "check_render", "make", "only_float_noise", "regenerate", "same_renderer",
+           "tolerance_for"]
 
 #: The sync whose drawing the goldens show.
 GOLDEN_SYNC = "reference"
@@ -158,10 +160,11 @@ class Change:
 
     scene: str
     frame: int
-    status: str  # "new", "changed", "unchanged"
+    status: str  # "new", "changed" (both written), "unchanged", "kept" (float noise only: not written)
     pixels: int = 0  # differing pixels against the old golden
     largest: int = 0  # largest channel difference
     physics: str = ""  # the physics difference against the old manifest, if it had one
+    state: str = ""  # the largest float difference of the states: the noise kept, or one beyond the bound
 
     def describe(self) -> str:
         where = f"{self.scene} frame {self.frame}"
@@ -169,15 +172,33 @@ class Change:
             return f"{where}: new"
         if self.status == "unchanged":
             return f"{where}: unchanged (byte-identical)"
+        if self.status == "kept":
+            return f"{where}: kept, not rewritten: same pixels, and the state differs only by float noise ({self.state})"
         picture = (f"{self.pixels} pixels differ (largest channel difference {self.largest})" if self.pixels
                    else "pixels identical")
-        return f"{where}: changed: {picture}" + (f"; physics: {self.physics}" if self.physics else "")
+        return (f"{where}: changed: {picture}" + (f"; physics: {self.physics}" if self.physics else "")
+                + (f"; state beyond float noise: {self.state}" if self.state else ""))
+
+
+def only_float_noise(old: storage.Golden, image: np.ndarray, made: dict[str, Any]) -> state.FloatNoise | None:
+    """The state's float noise when it is all that tells a fresh golden from ``old``: the same pixels,
+    every other manifest entry equal, and no float of the state farther than the bound; else None
+    (then the golden is written as usual). A state equal to the last bit is no noise: nothing to keep."""
+    fresh = storage.jsonable(made)
+    if (old.image.shape != image.shape or not np.array_equal(old.image, image)
+            or {k: v for k, v in fresh.items() if k != "state"} != {k: v for k, v in old.manifest.items() if k != "state"}):
+        return None
+    noise = state.float_noise(fresh["state"], old.state)
+    if noise is None or not noise.is_noise or storage.encode_manifest(fresh) == storage.encode_manifest(old.manifest):
+        return None
+    return noise
 
 
 def regenerate(scene_name: str, directory: Path | str, *, mode: str = "all", tolerance_override: str | None = None) -> list[Change]:
     """Make a scene's goldens anew and write those that ``mode`` selects: ``all``, ``missing``
     (missing or unreadable), or ``failing`` (missing, unreadable, or failing the render verdict
-    with the reference sync)."""
+    with the reference sync). A selected golden that differs only by float noise
+    (:func:`only_float_noise`) is kept: neither file is touched."""
     from conformance import images, scenes
 
     if mode not in ("all", "missing", "failing"):
@@ -198,6 +219,10 @@ def regenerate(scene_name: str, directory: Path | str, *, mode: str = "all", tol
 
             if compare.compare_images(old.image, image, tolerance_for(old, here, tolerance_override)).passed:
                 continue
+        noise = only_float_noise(old, image, made) if old is not None else None
+        if noise is not None:  # writing it would commit another CPU's last bits, and nothing else
+            changes.append(Change(scene_name, frame, "kept", state=noise.describe()))
+            continue
         png, _ = storage.paths(directory, scene_name, frame)
         existed = png.exists()
         if not storage.write(directory, scene_name, frame, image, made):
@@ -208,6 +233,8 @@ def regenerate(scene_name: str, directory: Path | str, *, mode: str = "all", tol
             continue
         pixels, largest = images.difference(old.image, image) if old.image.shape == image.shape else (image.size // 3, 255)
         physics = state.compare(made["state"], old.state)
+        noise = state.float_noise(storage.jsonable(made["state"]), old.state)
         changes.append(Change(scene_name, frame, "changed", pixels, largest,
-                              "" if physics.position == 0 and physics.angle == 0 else physics.describe()))
+                              "" if physics.position == 0 and physics.angle == 0 else physics.describe(),
+                              noise.describe() if noise is not None and not noise.is_noise else ""))
     return changes
