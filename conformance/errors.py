@@ -51,7 +51,8 @@ class BackendError(ConformanceError):
 
 
 class DisplayUnavailable(ConformanceError):
-    """No X display is set and none could be started for off-screen rendering."""
+    """No X display is set and none could be started for off-screen rendering, the X server refuses
+    connections, or VTK's OpenGL driver cannot start on it (:mod:`conformance.renderer_start`)."""
 
 
 class SyncError(ConformanceError):

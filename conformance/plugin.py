@@ -364,6 +364,7 @@ def pytest_runtest_makereport(item: pytest.Item, call):
     report = yield
     from conformance import survey
 
+    _only_the_paragraph(call, report)
     survey.settle(item, report)  # survey mode: a check that noted failures fails now, naming every kind
     if report.when == "call":
         from conformance import image_options
@@ -392,6 +393,15 @@ def pytest_runtest_makereport(item: pytest.Item, call):
             "diagnosis": next((line[len("diagnosis: "):] for line in message.splitlines() if line.startswith("diagnosis: ")), ""),
         }))
     return report
+
+
+def _only_the_paragraph(call, report: pytest.TestReport) -> None:
+    """A renderer or display that cannot start fails its check with the kit's paragraph alone: it
+    names the display, the driver and what to try, and the traceback through the backend adds nothing."""
+    from conformance.errors import BackendError, DisplayUnavailable
+
+    if report.failed and call.excinfo is not None and call.excinfo.errisinstance((BackendError, DisplayUnavailable)):
+        report.longrepr = f"{call.excinfo.typename}: {call.excinfo.value}"
 
 
 def _is_property(item: pytest.Item) -> bool:

@@ -2,11 +2,17 @@
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 from PIL import Image
 
-from conformance import cli, display, images
+import conformance
+from conformance import backends, cli, display, images
 from conformance.errors import DisplayUnavailable
 
 
@@ -124,3 +130,139 @@ def test_xvfb_that_fails_to_start_is_a_clear_error(monkeypatch):
     with pytest.raises(DisplayUnavailable, match=r"Xvfb is installed but did not start \(exit status \d+; it said: .+\)"):
         display.ensure_display()
     assert "DISPLAY" not in __import__("os").environ and display._started is None
+
+
+# -- a renderer that cannot start (conformance/renderer_start.py) ---------------------------------------
+
+#: Per backend: an environment its renderer cannot start in, and what the kit's paragraph must say.
+BROKEN = {
+    "vtk": ({"GALLIUM_DRIVER": "zink"},  # without LIBGL_ALWAYS_SOFTWARE=1 VTK aborts: exit status 134
+            ["VTK cannot start its OpenGL renderer", "GALLIUM_DRIVER='zink'", "was killed by signal 6 (SIGABRT)",
+             "unset GALLIUM_DRIVER", "set LIBGL_ALWAYS_SOFTWARE=1 GALLIUM_DRIVER=zink and XDG_RUNTIME_DIR"]),
+    "pygfx": ({"WGPU_BACKEND_TYPE": "Metal"},  # a backend wgpu was not built with: no adapter
+              ["FURY 2 renders through wgpu, which could not start", "WGPU_BACKEND_TYPE='Metal'",
+               "No suitable graphics adapter found", "unset WGPU_BACKEND_TYPE", "mesa-vulkan-drivers"]),
+}
+
+
+def _environment(**variables) -> dict[str, str]:
+    """This process's environment for a child of the kit's, with every driver variable replaced by
+    ``variables``, and this checkout's ``conformance`` first on the path (a worktree's, not an install's)."""
+    from conformance import renderer_start as rs
+
+    dropped = set(rs.GL_VARIABLES + rs.WGPU_VARIABLES) | {rs.PROBED_VARIABLE, "PYTHONFAULTHANDLER"}
+    env = {k: v for k, v in display.child_environment().items() if k not in dropped}
+    checkout = str(Path(conformance.__file__).resolve().parents[1])
+    env["PYTHONPATH"] = os.pathsep.join(filter(None, [checkout, os.environ.get("PYTHONPATH")]))
+    return {**env, **variables}
+
+
+def _run(argv, cwd, **variables) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, *argv], cwd=cwd, env=_environment(**variables), capture_output=True,
+                          text=True, timeout=300, stdin=subprocess.DEVNULL)
+
+
+def _said(done: subprocess.CompletedProcess) -> str:
+    return f"status {done.returncode}\n{done.stdout[-3000:]}\n{done.stderr[-3000:]}"
+
+
+def test_a_renderer_that_cannot_start_is_one_paragraph_on_the_command_line(tmp_path):
+    variables, phrases = BROKEN[backends.NAME]
+    done = _run(["-m", "conformance", "render", "free_fall", "--step", "10", "--out", str(tmp_path / "ff.png")],
+                tmp_path, **variables)
+    assert done.returncode == 2, _said(done)  # the kit's error status, not 134 (SIGABRT) or a negative one
+    errors = [line for line in done.stderr.splitlines() if line.startswith("error: ")]
+    assert len(errors) == 1 and all(phrase in errors[0] for phrase in phrases), _said(done)
+    assert "Fatal Python error" not in done.stderr and "Traceback" not in done.stderr, _said(done)
+    assert not (tmp_path / "ff.png").exists()
+
+
+def test_a_renderer_that_cannot_start_fails_the_checks_with_the_paragraph_under_pytest(tmp_path):
+    variables, phrases = BROKEN[backends.NAME]
+    done = _run(["-m", "pytest", "--pyargs", "conformance", "-p", "no:cacheprovider", "-q", "-k",
+                 "test_golden_render and free_fall", "--conformance-results", str(tmp_path / "results")],
+                tmp_path, **variables)
+    assert done.returncode == 1, _said(done)  # checks failed: not 134, not an internal error (3)
+    kind = "DisplayUnavailable" if backends.NAME == "vtk" else "BackendError"
+    paragraphs = [line for line in done.stdout.splitlines() if line.startswith(f"{kind}: ")]
+    assert len(paragraphs) == 1 and all(phrase in paragraphs[0] for phrase in phrases), _said(done)
+    assert "Fatal Python error" not in done.stderr and "1 failed" in done.stdout, _said(done)
+
+
+vtk_only = pytest.mark.skipif(backends.NAME != "vtk", reason="FURY 2 renders without OpenGL or X")
+
+
+@vtk_only
+@pytest.mark.parametrize("variables", [
+    {"LIBGL_ALWAYS_SOFTWARE": "1", "GALLIUM_DRIVER": "softpipe"},
+    {"LIBGL_ALWAYS_SOFTWARE": "1", "GALLIUM_DRIVER": "zink", "XDG_RUNTIME_DIR": None},  # set to tmp_path below
+], ids=["softpipe", "zink"])
+def test_a_driver_that_can_start_still_renders(tmp_path, variables):
+    variables = {k: v if v is not None else str(tmp_path) for k, v in variables.items()}
+    out = tmp_path / "ff.png"
+    done = _run(["-m", "conformance", "render", "free_fall", "--step", "10", "--size", "120", "90", "--out", str(out)],
+                tmp_path, **variables)
+    assert done.returncode == 0, _said(done)
+    assert (np.asarray(Image.open(out)) != 255).any(), "the picture is blank: nothing was drawn"
+
+
+@vtk_only
+def test_an_opengl_older_than_3_2_is_refused_too(monkeypatch):
+    """VTK neither aborts nor draws here: it logs an error and goes on."""
+    from conformance import renderer_start
+
+    display.ensure_display()
+    monkeypatch.setenv("MESA_GL_VERSION_OVERRIDE", "3.0")
+    with pytest.raises(DisplayUnavailable, match=r"MESA_GL_VERSION_OVERRIDE='3\.0'.*exited with status 1, saying: "
+                       r".*VTK found no OpenGL 3\.2 or later.* To fix it, unset MESA_GL_VERSION_OVERRIDE") as raised:
+        renderer_start.check_gl()
+    assert "\n" not in str(raised.value)
+
+
+def test_the_probe_runs_once_per_process_and_environment(monkeypatch):
+    from conformance import renderer_start
+
+    answers = iter([None, "the paragraph"])
+    probes = []
+    monkeypatch.setattr(renderer_start, "_answers", {})
+    monkeypatch.setattr(renderer_start, "_probe", lambda: probes.append(1) or next(answers))
+    monkeypatch.delenv(renderer_start.PROBED_VARIABLE, raising=False)
+    monkeypatch.delenv("GALLIUM_DRIVER", raising=False)
+    renderer_start.check_gl()
+    renderer_start.check_gl()
+    assert len(probes) == 1
+    monkeypatch.setenv("GALLIUM_DRIVER", "zink")  # another environment: asked again, and the error kept
+    for _ in range(2):
+        with pytest.raises(DisplayUnavailable, match="the paragraph"):
+            renderer_start.check_gl()
+    assert len(probes) == 2
+    monkeypatch.delenv("GALLIUM_DRIVER")
+    monkeypatch.setattr(renderer_start, "_answers", {})  # a child process, which inherits the parent's pass
+    renderer_start.check_gl()
+    assert len(probes) == 2
+
+
+def test_what_the_child_said_is_one_line_without_vtks_log_prefix():
+    from conformance.renderer_start import last_words
+
+    stderr = ("pybullet build time: Jan 29 2025 23:17:20\nlibGL error: failed to load driver: swrast\n"
+              "\x1b[0m\x1b[31m2026-11-25 15:20:18.086 (   0.183s) [    7FD697A1DB80]vtkXOpenGLRenderWindow.:651    ERR| "
+              "vtkXOpenGLRenderWindow (0x55c24ce9f2f0): Cannot create GLX context.  Aborting.\x1b[0m\n")
+    assert last_words(stderr) == "libGL error: failed to load driver: swrast; Cannot create GLX context. Aborting."
+    assert last_words("") == "(nothing)"
+
+
+@vtk_only
+def test_an_app_whose_driver_cannot_start_gets_the_paragraph(monkeypatch):
+    """App mode: the app's own process probes before the app makes its window, which would abort it."""
+    from conformance import renderer_start
+    from conformance.apps import launch
+
+    for name in renderer_start.GL_VARIABLES:
+        monkeypatch.delenv(name, raising=False)
+    monkeypatch.setenv("GALLIUM_DRIVER", "zink")
+    with pytest.raises(launch.AppFailed) as raised:
+        launch.record(Path(__file__).parent / "apps" / "box_vtk.py", ticks=2)
+    message = str(raised.value)
+    assert "box_vtk.py: VTK cannot start its OpenGL renderer" in message and "GALLIUM_DRIVER='zink'" in message
+    assert "unset GALLIUM_DRIVER" in message and "\n" not in message

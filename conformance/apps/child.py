@@ -4,7 +4,7 @@ Runs the app's script unmodified as ``__main__`` (with ``sys.argv = [SCRIPT]`` a
 ``sys.path``, as ``python SCRIPT`` would), with the kit's patches (:mod:`conformance.apps.driver`) in
 place, and writes what it recorded to ``--out``. Exit status: 0 recorded (the app may still have
 raised inside its loop: the recording says so), 3 the app failed before its loop or handed over no
-loop (``--out`` + ``.error`` holds the paragraph). Run by :mod:`conformance.apps.launch`, in a process of
+loop, or (FURY 0.12) the OpenGL driver cannot start (``--out`` + ``.error`` holds the paragraph). Run by :mod:`conformance.apps.launch`, in a process of
 its own so that an app's globals, patches, crashes and hangs never reach the kit's.
 """
 
@@ -43,8 +43,14 @@ def main(argv=None) -> int:
     name = backends.NAME
     if name == "vtk":
         from conformance.display import ensure_display
+        from conformance.errors import DisplayUnavailable
+        from conformance.renderer_start import check_gl
 
         ensure_display()
+        try:
+            check_gl()  # the app's window would abort this process where the driver cannot start
+        except DisplayUnavailable as err:
+            return _fail(args.out, f"{args.script}: {err}")
         from conformance.apps import takeover_vtk as takeover
     else:
         os.environ.setdefault("XDG_RUNTIME_DIR", "/tmp")

@@ -26,6 +26,7 @@ import numpy as np
 
 from conformance.backends.common import Drawing, decode_ids, id_codes, lay_out, moved_range, transformed, turned_normals
 from conformance.errors import BackendError
+from conformance.renderer_start import WGPU_VARIABLES, asked_for, set_among
 
 __all__ = ["ANNOUNCE", "LIGHTING", "MULTISAMPLES", "NAME", "Drawing", "build", "content_state", "content_time", "flush", "hand_over", "mesh_signature", "perturbed", "render", "render_ids",
            "renderer_info", "world_normals", "world_vertices"]
@@ -233,6 +234,7 @@ def mesh_signature(actor) -> tuple[int, str, str]:
 
 _canvas = None  # one off-screen canvas and renderer per process, made on first use
 _renderer = None
+_start_error = None  # the paragraph, once wgpu failed to start in this process
 _warm_up = None  # a second, tiny one for the first draw of every drawing (resizing costs more than it)
 _WARM_UP_SIZE = (8, 8)
 _stages: "weakref.WeakKeyDictionary[Drawing, Any]" = weakref.WeakKeyDictionary()
@@ -251,7 +253,9 @@ def _warm_up_canvas():
 
 
 def _canvas_and_renderer(size: tuple[int, int]):
-    global _canvas, _renderer
+    global _canvas, _renderer, _start_error
+    if _start_error is not None:  # asked once per process: wgpu takes a second or more to fail again
+        raise BackendError(_start_error)
     if _canvas is None:
         os.environ.setdefault("XDG_RUNTIME_DIR", "/tmp")  # wgpu's Vulkan loader only warns without it
         import pygfx
@@ -261,14 +265,21 @@ def _canvas_and_renderer(size: tuple[int, int]):
             _canvas = RenderCanvas(size=tuple(size), pixel_ratio=1)
             _renderer = pygfx.WgpuRenderer(_canvas, pixel_ratio=1)
         except Exception as exc:  # wgpu raises its own types for a missing adapter or driver
-            _canvas = None
-            raise BackendError(
-                f"FURY 2 renders through wgpu, which could not start ({type(exc).__name__}: {exc}). Without a GPU it "
-                "needs Mesa's Vulkan driver: `apt-get install mesa-vulkan-drivers` (Debian/Ubuntu), or run "
-                "`./kit setup --backend pygfx`, which installs it.") from exc
+            _canvas, _start_error = None, _cannot_start(exc)
+            raise BackendError(_start_error) from exc
     if tuple(_canvas.get_logical_size()) != tuple(float(v) for v in size):
         _canvas.set_logical_size(*size)
     return _canvas, _renderer
+
+
+def _cannot_start(exc: Exception) -> str:
+    """One paragraph: wgpu's complaint on one line, the adapter and driver variables set, what to try."""
+    chosen = set_among(WGPU_VARIABLES)
+    unset = f"unset {' and '.join(chosen)} to let wgpu choose its own library, backend and adapter; otherwise, " if chosen else ""
+    return (f"FURY 2 renders through wgpu, which could not start with {asked_for(WGPU_VARIABLES)} "
+            f"({type(exc).__name__}: {' '.join(str(exc).split())}). To fix it, {unset}without a GPU wgpu needs "
+            "Mesa's Vulkan driver: `apt-get install mesa-vulkan-drivers` (Debian/Ubuntu), or run "
+            "`./kit setup --backend pygfx`, which installs it.")
 
 
 class _Stage:
