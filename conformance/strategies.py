@@ -93,9 +93,9 @@ def offsets(scale: float = 0.5) -> st.SearchStrategy[tuple[float, float, float]]
     return st.tuples(component, component, component)
 
 
-def frame_counts(longest: int = 60) -> st.SearchStrategy[int]:
-    """Run lengths from nothing (only the frame-0 sync) up to ``longest``; short runs often."""
-    return st.one_of(st.sampled_from([0, 1, 2]), st.integers(0, longest))
+def frame_counts(longest: int = 60, shortest: int = 0) -> st.SearchStrategy[int]:
+    """Run lengths from ``shortest`` (0: only the frame-0 sync) up to ``longest``; short runs often."""
+    return st.one_of(st.sampled_from([n for n in (0, 1, 2) if n >= shortest]), st.integers(shortest, longest))
 
 
 def _events_at(frames: int):

@@ -20,9 +20,12 @@ from conformance.pytest_helpers import _context, bounds_figure, each_scene, repr
 
 
 def _scene_runs(scene_name: str, longest: int):
-    """(parameters, frame count, events) for one scene, drawn together so events fit the run."""
+    """(parameters, frame count, events) for one scene, drawn together so events fit the run. At least one
+    step: under flatmap Hypothesis draws frame 0 alone often, and with the default profile's four
+    examples a sync drawing the previous step passed (``--hypothesis-seed=1``: 1 seed of 1–60 on
+    free_fall); frame 0 alone is every other vertex check's first frame."""
     return strategies.scene_parameters(scene_name).flatmap(
-        lambda params: strategies.frame_counts(longest).flatmap(
+        lambda params: strategies.frame_counts(longest, shortest=1).flatmap(
             lambda frames: st.tuples(st.just(params), st.just(frames), strategies.events(frames))))
 
 
@@ -108,7 +111,7 @@ def test_vertices_match_poses_every_frame(scene_name, kit):
 
 @each_scene()
 def test_vertices_match_through_teleports_and_kicks(scene_name, kit):
-    """Hypothesis varies the scene's parameters, the run's length (0 frames up) and what happens
+    """Hypothesis varies the scene's parameters, the run's length (1 frame up) and what happens
     between syncs: ``resetBasePositionAndOrientation`` to any orientation, ``resetJointState``,
     and forces and torques that set bodies moving and spinning."""
 

@@ -149,3 +149,20 @@ def test_each_frame_is_judged_on_its_own_announcement():
     with Kit(implementation, DEFAULT).run("brick_wall_single") as run:
         run.advance(3)
     assert [frame for frame, actor in run.unannounced if actor == "bricks"] == [0, 3]
+
+
+def test_teleport_check_runs_at_least_one_step_whatever_hypothesis_draws():
+    """Measured before the fix: with --hypothesis-seed=1 the default profile drew only runs of frame 0
+    alone, and a sync one step late passed (1 seed of 1–60); each run now has a step to be late on."""
+    from hypothesis import given, seed, settings
+
+    frames_seen = []
+
+    @seed(1)
+    @settings(max_examples=20, database=None, deadline=None)
+    @given(run_plan=checks._scene_runs("free_fall", longest=40))
+    def draw(run_plan):
+        frames_seen.append(run_plan[1])
+
+    draw()
+    assert min(frames_seen) >= 1, f"frames={frames_seen}, but every run should step at least once"
