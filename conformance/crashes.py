@@ -36,6 +36,8 @@ import signal
 import tempfile
 from pathlib import Path
 
+import pytest
+
 from conformance.errors import SyncCrashed
 
 __all__ = ["CHOICES", "Controller", "Journal", "arrange", "check_not_crashed", "noting"]
@@ -143,6 +145,19 @@ class Controller:
     def pytest_configure_node(self, node) -> None:
         node.workerinput[_INPUT_KEY] = str(self.directory)
 
+    @pytest.hookimpl(wrapper=True)
+    def pytest_runtestloop(self, session):
+        """``-x`` / ``--maxfail`` reached in a worker ends pytest-xdist's run as an interruption (exit
+        status 2); in pytest's own process the same run ends with its failures (exit status 1), which
+        is what scripts and ``kill-rate`` read. Say it as pytest does."""
+        try:
+            return (yield)
+        except KeyboardInterrupt as exc:  # xdist's own Interrupted, not pytest's
+            if session.testsfailed and str(exc).startswith("stopping after") and session.config.option.maxfail:
+                session.shouldfail = str(exc)
+                return True
+            raise
+
     def pytest_handlecrashitem(self, crashitem: str, report, sched) -> None:
         worker = report.node.gateway.id
         where = self._read_where(worker, crashitem)
@@ -220,7 +235,10 @@ def _stack_lines(stack: str) -> str:
     ours.reverse()  # faulthandler prints the innermost call first
     header = next((line.strip() for line in stack.splitlines() if line.startswith("Fatal Python error")), "")
     body = "\n".join(f"  {line}" for line in ours[-12:])
-    return (header + "\n" if header else "") + (body or "  (no stack: the process ended without a fatal signal)")
+    if not body and stack.strip():  # not the dump's usual shape: show what it did write
+        body = "\n".join(f"  {line}" for line in stack.strip().splitlines()[-12:])
+    return (header + "\n" if header and header not in body else "") + (
+        body or "  (no stack: the process ended without a fatal signal, or before faulthandler could write)")
 
 
 def _check_name(nodeid: str) -> str:

@@ -225,9 +225,10 @@ def pytest_configure(config: pytest.Config) -> None:
 
 
 def _watch_for_crashes(config: pytest.Config) -> None:
-    """In workers: the crash journal. In pytest-xdist's controller: the crash handler, xdist's restart cap
-    raised to a crash per scene, and the sync loaded once here too, so that a sync that cannot be loaded
-    is the usual one-paragraph usage error rather than a worker's internal error."""
+    """In pytest-xdist's controller: the crash handler, xdist's restart cap raised to a crash per scene,
+    and the sync loaded and the options read once here too, so that a sync that cannot be loaded or a
+    bad value is the usual one-paragraph usage error rather than a worker's internal error (workers
+    start their journal at ``pytest_sessionstart``)."""
     from conformance import crashes
 
     if hasattr(config, "workerinput"):
@@ -239,6 +240,7 @@ def _watch_for_crashes(config: pytest.Config) -> None:
     crashes.allow_restarts(config, len(scenes.names()))
     spec = _sync_spec(config)
     config.pluginmanager.register(crashes.Controller(config, spec, _RECORD_PROPERTY), "conformance-crashes")
+    _option(config, "sync_timeout"), tolerance_from(config)  # a bad value: the usage error, here, once
     from conformance.sync import SHORT_NAMES
 
     if spec not in SHORT_NAMES:

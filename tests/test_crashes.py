@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import os
 import subprocess
+import time
 from pathlib import Path
 
 import pytest
@@ -36,6 +37,10 @@ def run(pytester, monkeypatch):
         before = _xvfb()
         result = pytester.runpytest_subprocess(*SUBSET, "--sync", sync, "--conformance-report", str(report), *args)
         left = _xvfb() - before
+        deadline = time.monotonic() + 10  # a dead worker's Xvfb gets SIGTERM from the kernel, and takes a moment
+        while left and time.monotonic() < deadline:
+            time.sleep(0.1)
+            left = _xvfb() - before
         assert not left, f"Xvfb {sorted(left)} left running after the run, but should have died with its worker"
         records = json.loads(report.read_text())["records"] if report.exists() else []
         return result, records, result.stdout.str()
@@ -87,6 +92,12 @@ def test_without_isolation_a_crash_ends_the_run_as_it_would_without_the_kit(run)
     result, records, text = run("crashing_syncs:SegfaultsOnFreeFall", "--conformance-isolation", "none")
     assert result.ret not in (pytest.ExitCode.OK, pytest.ExitCode.TESTS_FAILED), text  # killed: no verdict
     assert records == []
+
+
+def test_x_stops_at_the_first_failure_with_pytests_own_exit_status(run):
+    result, records, text = run("crashing_syncs:SegfaultsOnFreeFall", "-x")
+    assert result.ret == pytest.ExitCode.TESTS_FAILED, text  # not xdist's INTERRUPTED
+    assert "stopping after 1 failures" in text and "crashing_syncs.py" in text, text
 
 
 def test_an_isolation_that_is_not_a_choice_is_refused(pytester):
