@@ -79,7 +79,7 @@ def check_frame(run, frame: int) -> FrameCheck:
     normals = compare.compare_normals(run.drawing, frame)
     ranked = [(_ratio(r.error, r.tolerance), r.describe()) for r in vertices if not r.ok]
     ranked += [(_ratio(r.angle, r.tolerance), r.describe()) for r in normals if not r.ok]
-    unannounced = [f"actor {name!r} changed unannounced" for f, name in run.unannounced if f == frame]
+    unannounced = [f"actor {name!r}: {missed}" for f, name, missed in run.unannounced if f == frame]
     problems = tuple([text for _, text in ranked] + unannounced)
     worst = max(vertices, key=lambda r: _ratio(r.error, r.tolerance)).describe() if vertices else "no targets"
     worst_problem = max(ranked, key=lambda item: item[0])[1] if ranked else (unannounced[0] if unannounced else None)

@@ -299,6 +299,6 @@ def diagnose_problems(run) -> str:
     normals = [r for r in compare.compare_normals(run.drawing, run.frame) if not r.ok]
     if normals:
         return diagnose_normals(run, max(normals, key=lambda r: r.angle))
-    if any(frame == run.frame for frame, _ in run.unannounced):
+    if any(frame == run.frame for frame, *_ in run.unannounced):
         return unannounced()
     return ""

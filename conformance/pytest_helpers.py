@@ -121,11 +121,11 @@ def _normals_message(failures: Sequence[Any], run: Any, sync: str) -> str:
                       "reproduce: " + reproduce_command(run.scene.name, sync, worst.frame, run.params, run.events)])
 
 
-def _unannounced_message(frame: int, actor: str, run: Any, sync: str) -> str:
+def _unannounced_message(frame: int, actor: str, missed: str, run: Any, sync: str) -> str:
     from conformance import backends
 
-    return (f"actor {actor!r}: the sync changed its vertex data at frame {frame} without marking it modified "
-            f"(no {backends.ANNOUNCE}), so a live window keeps drawing the old vertices "
+    return (f"actor {actor!r}: at frame {frame} {missed}: the sync changed its vertex data without marking it "
+            f"modified (no {backends.ANNOUNCE} covering it), so a live window keeps drawing the old ones "
             f"{_context(run, sync, frame)}\n{diagnosis.unannounced()}")
 
 
@@ -150,8 +150,8 @@ def assert_changes_announced(run: Any, *, sync: str) -> None:
     renderer keeps drawing the old vertices (FURY's ``utils.update_actor`` does this)."""
     __tracebackhide__ = True
     if run.unannounced:
-        frame, actor = run.unannounced[0]
-        pytest.fail(_unannounced_message(frame, actor, run, sync), pytrace=False)
+        frame, actor, missed = run.unannounced[0]
+        pytest.fail(_unannounced_message(frame, actor, missed, run, sync), pytrace=False)
 
 
 def assert_geometry_matches(results: Iterable[Any], *, scene: str, params: Mapping[str, Any], frame: int) -> None:
@@ -238,8 +238,9 @@ class Kit:
             self._failed("normals", lambda: _normals_message(turned, run, sync), value=worst.angle,
                          limit=worst.tolerance, unit="rad", frame=worst.frame, target=worst.target)
         seen = self._announced.get(run, 0)
-        for frame, actor in run.unannounced[seen:]:
-            self._failed("Modified", lambda: _unannounced_message(frame, actor, run, sync), frame=frame, target=actor)
+        for frame, actor, missed in run.unannounced[seen:]:
+            self._failed("Modified", lambda: _unannounced_message(frame, actor, missed, run, sync), frame=frame,
+                         target=actor)
         self._announced[run] = len(run.unannounced)
 
     def _picture(self, run: Any, failures: Sequence[Any], message: str | None, drawn: Callable[[], dict[str, Any]]) -> None:

@@ -37,7 +37,7 @@ class Run:
         #: Each actor's vertex count, topology and colours as built, before any sync.
         self.built_mesh = {name: backends.mesh_signature(a) for name, a in self.drawing.actors.items()}
         #: (frame, actor name) of every sync that changed an actor's data without telling the renderer.
-        self.unannounced: list[tuple[int, str]] = []
+        self.unannounced: list[tuple[int, str, str]] = []  # (frame, actor, what was not announced)
         self._after: dict[str, tuple[int, bytes]] = {}
         self._items = [(t.body, t.link) for t in self.drawing.targets]
         # pyBullet's readings of every target when the current frame began, before its events and step
@@ -92,8 +92,9 @@ class Run:
         self.syncer(self.frame)
         self._after = {name: backends.content_state(a) for name, a in actors.items()}
         for name, after in self._after.items():
-            if after[1] != before[name][1] and not backends.announced(actors[name], before[name], after):
-                self.unannounced.append((self.frame, name))
+            missed = backends.unannounced(actors[name], before[name], after) if after[1] != before[name][1] else None
+            if missed:
+                self.unannounced.append((self.frame, name, missed))
         backends.flush(self.drawing)
 
     def advance(self, frames: int = 1) -> None:

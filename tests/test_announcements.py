@@ -6,6 +6,7 @@ reaches the screen). On FURY 0.12 one ``Modified()`` re-uploads the whole geomet
 from __future__ import annotations
 
 import os
+import re
 from pathlib import Path
 
 import pytest
@@ -32,6 +33,10 @@ def _unannounced(spec: str, scene: str = "mixed_shapes", params=SHARED, frames: 
 def test_a_change_left_unannounced_in_a_buffer_or_a_range_is_found(spec, scene, params):
     found = _unannounced(spec, scene, params)
     assert found, f"{spec} on {scene}({params}): no unannounced change found, but its un-uploaded changes should be"
+    buffer = "normals" if "Normals" in spec else "positions"
+    frame, actor, missed = found[0]
+    assert re.fullmatch(rf"its {buffer} changed at vertices? \d+(–\d+)?.*, (outside every range|with nothing) announced "
+                        r"on them", missed), missed
 
 
 @pytest.mark.parametrize("spec", ["reference", "right_syncs_pygfx:PerTargetSync", "guide-vertex"])
@@ -50,3 +55,4 @@ def test_the_check_fails_a_sync_that_announces_only_the_positions(pytester, monk
                                 "-k", "test_vertices_match_poses_every_frame and mixed_shapes")
     result.assert_outcomes(failed=1)
     assert "without marking it modified" in result.stdout.str() and "diagnosis:" in result.stdout.str()
+    assert re.search(r"actor '\w+': at frame \d+ its normals changed at vertices \d+", result.stdout.str()), result.stdout.str()

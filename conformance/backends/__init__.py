@@ -33,8 +33,8 @@ import importlib.metadata
 
 from conformance.errors import BackendError
 
-__all__ = ["ANNOUNCE", "LIGHTING", "MULTISAMPLES", "NAME", "NAMES", "Drawing", "announced", "build", "content_state", "content_time", "describe", "flush", "fury_version", "hand_over", "mesh_signature", "perturbed",
-           "render", "render_ids", "renderer_info", "renderer_label", "world_normals", "world_vertices"]
+__all__ = ["ANNOUNCE", "LIGHTING", "MULTISAMPLES", "NAME", "NAMES", "Drawing", "build", "content_state", "content_time", "describe", "flush", "fury_version", "hand_over", "mesh_signature", "perturbed",
+           "render", "render_ids", "renderer_info", "renderer_label", "unannounced", "world_normals", "world_vertices"]
 
 #: Backend names and the FURY each one is: the ``./kit --backend`` values and ``golden/<name>/``.
 NAMES = {"vtk": "FURY 0.12 (VTK)", "pygfx": "FURY 2 (pygfx/wgpu)"}

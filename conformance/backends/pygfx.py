@@ -113,7 +113,7 @@ def flush(drawing: Drawing) -> None:
 
     replaced = False
     for actor in drawing.actors.values():
-        for buffer in _buffers(actor):
+        for _, buffer in _buffers(actor):
             if buffer._wgpu_object is None:
                 replaced = True
             else:
@@ -169,9 +169,9 @@ def world_normals(actor) -> np.ndarray | None:
     return None if normals is None else turned_normals(normals, _matrix(actor))
 
 
-def _buffers(actor) -> list:
+def _buffers(actor) -> list[tuple[str, object]]:
     geometry = actor.geometry
-    return [b for b in (geometry.positions, getattr(geometry, "normals", None)) if b is not None]
+    return [(name, b) for name in ("positions", "normals") if (b := getattr(geometry, name, None)) is not None]
 
 
 def hand_over(actor) -> None:
@@ -180,45 +180,57 @@ def hand_over(actor) -> None:
     and uploads them. Until that happens a buffer stays "wholly pending" and further ``update_range``
     calls do not move its revision, so a change announced every frame would look unannounced. App mode
     calls this after every tick, where the app's own window does not draw."""
-    for buffer in _buffers(actor):
+    for _, buffer in _buffers(actor):
         buffer._gfx_get_chunk_descriptions()
 
 
 def content_time(actor) -> int:
     """The newest revision of the actor's position and normal buffers: pygfx bumps a buffer's revision
     on every ``update_range``/``update_full``/``update_indices``, and a new buffer has a new one."""
-    return max(b._rev for b in _buffers(actor))
+    return max(b._rev for _, b in _buffers(actor))
 
 
 def content_state(actor) -> tuple[int, bytes]:
     """The revision (:func:`content_time`) and a copy of the position and normal data, to tell a change
     pygfx was told about from one it was not (pygfx uploads only announced ranges)."""
-    return content_time(actor), b"".join(bytes(memoryview(np.ascontiguousarray(b.data))) for b in _buffers(actor))
+    return content_time(actor), b"".join(bytes(memoryview(np.ascontiguousarray(b.data))) for _, b in _buffers(actor))
 
 
-def announced(actor, before: tuple[int, bytes], after: tuple[int, bytes]) -> bool:
-    """Whether every item of the actor's position and normal buffers that changed from ``before`` to
-    ``after`` (:func:`content_state`) will reach the GPU: pygfx uploads only the chunks that
-    ``update_range``/``update_indices`` marked (or the whole buffer after ``update_full`` or when new), so
-    a changed vertex outside them, or a buffer changed while another was announced, stays old on screen.
-    Read after the sync and before the changes are handed over (:func:`flush`, :func:`hand_over`)."""
+def unannounced(actor, before: tuple[int, bytes], after: tuple[int, bytes]) -> str | None:
+    """What of the actor's position and normal buffers changed from ``before`` to ``after``
+    (:func:`content_state`) and will not reach the GPU, as "its normals changed at vertices 120–239,
+    outside every range announced on them"; ``None`` when every change will. pygfx uploads only the
+    chunks that ``update_range``/``update_indices`` marked (or the whole buffer after ``update_full`` or
+    when new), so a changed vertex outside them, or a buffer changed while another was announced, stays
+    old on screen. Read after the sync and before the changes are handed over (:func:`flush`, :func:`hand_over`)."""
     buffers = _buffers(actor)
     old, new = before[1], after[1]
     if len(old) != len(new):  # a buffer replaced by one of another size: new buffers are wholly pending
-        return all(b._chunks_dirt_flag == 2 for b in buffers)
+        stale = [name for name, b in buffers if b._chunks_dirt_flag != 2]
+        return f"its {' and '.join(stale)} were replaced by buffers of another size, not announced whole" if stale else None
     offset = 0
-    for buffer in buffers:
+    for name, buffer in buffers:
         size = np.asarray(buffer.data).nbytes
         was, now = old[offset:offset + size], new[offset:offset + size]
         offset += size
         if was == now or buffer._chunks_dirt_flag == 2:
             continue
+        changed = np.flatnonzero((np.frombuffer(was, np.uint8) != np.frombuffer(now, np.uint8))
+                                 .reshape(max(buffer.nitems, 1), -1).any(axis=1))
         if not buffer._chunks_dirt_flag or not buffer.nitems:
-            return False
-        items = (np.frombuffer(was, np.uint8) != np.frombuffer(now, np.uint8)).reshape(buffer.nitems, -1).any(axis=1)
-        if not buffer._chunk_mask[np.flatnonzero(items) // buffer._chunk_size].all():
-            return False
-    return True
+            return f"its {name} changed at {_vertices(changed)}, with nothing announced on them"
+        missed = changed[~buffer._chunk_mask[changed // buffer._chunk_size]]
+        if missed.size:
+            return f"its {name} changed at {_vertices(missed)}, outside every range announced on them"
+    return None
+
+
+def _vertices(items: np.ndarray) -> str:
+    """``vertices 3–7`` or ``vertices 3–7 and 12–20 (9 of them)``: the runs of changed items, the first two."""
+    runs = np.split(items, np.flatnonzero(np.diff(items) != 1) + 1)
+    spans = [f"{r[0]}" if r.size == 1 else f"{r[0]}–{r[-1]}" for r in runs[:2]]
+    more = f" and {len(runs) - 2} more runs" if len(runs) > 2 else ""
+    return f"vertex {spans[0]}" if items.size == 1 else f"vertices {' and '.join(spans)}{more} ({items.size} of them)"
 
 
 def mesh_signature(actor) -> tuple[int, str, str]:

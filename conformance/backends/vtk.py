@@ -155,11 +155,18 @@ def content_state(actor) -> tuple[int, bytes]:
     return data.GetMTime(), content
 
 
-def announced(actor, before: tuple[int, bytes], after: tuple[int, bytes]) -> bool:
-    """Whether a change of the actor's data from ``before`` to ``after`` (:func:`content_state`) was
-    announced: VTK's mapper re-uploads all of the geometry (points and normals) when the data's
-    modification time moved, whichever array's ``Modified()`` moved it."""
-    return after[0] > before[0]
+def unannounced(actor, before: tuple[int, bytes], after: tuple[int, bytes]) -> str | None:
+    """What changed from ``before`` to ``after`` (:func:`content_state`) without reaching the GPU, or
+    ``None``: VTK's mapper re-uploads all of the geometry (points and normals) when the data's
+    modification time moved, whichever array's ``Modified()`` moved it, so a change is unannounced only
+    when nothing moved it."""
+    if after[0] > before[0]:
+        return None
+    points = actor.GetMapper().GetInput().GetPoints().GetData()
+    size = points.GetNumberOfTuples() * points.GetNumberOfComponents() * points.GetDataTypeSize()
+    which = [name for name, (a, b) in (("points", (before[1][:size], after[1][:size])),
+                                      ("normals", (before[1][size:], after[1][size:]))) if a != b]
+    return f"its {' and '.join(which)} changed, and no Modified() followed"
 
 
 def mesh_signature(actor) -> tuple[int, str, str]:

@@ -187,10 +187,10 @@ def scene_report(result) -> str:
         if unannounced:
             from conformance import backends
 
-            frame, actor = unannounced[0]
+            frame, actor, missed = unannounced[0]
             lines.append(f"  {side} ({spec!r}) changed vertex data without {backends.ANNOUNCE} in "
                          f"{len(unannounced)} sync call{'s' if len(unannounced) != 1 else ''} (first: actor {actor!r} at "
-                         f"frame {frame}): a live window keeps drawing the old vertices")
+                         f"frame {frame}: {missed}): a live window keeps drawing the old vertices")
     if result.physics_diverged is not None and not result.touched_physics:
         lines.append(f"  the two runs' pyBullet poses differ from frame {result.physics_diverged} on, though neither "
                      "sync call changed the state: each side is judged against its own run")
