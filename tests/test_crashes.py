@@ -21,9 +21,16 @@ SUBSET = ["--pyargs", "conformance", "-p", "no:cacheprovider", "--hypothesis-pro
 
 
 def _xvfb() -> set[int]:
-    """Xvfb servers alive (a zombie has died already; whoever inherits it reaps it)."""
-    rows = subprocess.run(["ps", "-C", "Xvfb", "-o", "pid=,stat="], capture_output=True, text=True).stdout.split("\n")
-    return {int(row.split()[0]) for row in rows if row.strip() and not row.split()[1].startswith("Z")}
+    """Xvfb servers alive whose parent is gone: left behind. A zombie has died already (whoever inherits
+    it reaps it); a server whose parent lives is someone else's, e.g. one of the kit's own background runs
+    (tests/background.py) started while this test ran."""
+    rows = subprocess.run(["ps", "-C", "Xvfb", "-o", "pid=,stat=,ppid="], capture_output=True, text=True).stdout
+    orphans = set()
+    for pid, stat, parent in (row.split() for row in rows.splitlines() if row.strip()):
+        if not stat.startswith("Z") and (parent == "1" or not Path(f"/proc/{parent}/cmdline").exists()
+                                         or b"python" not in Path(f"/proc/{parent}/cmdline").read_bytes()):
+            orphans.add(int(pid))
+    return orphans
 
 
 @pytest.fixture
