@@ -19,8 +19,8 @@ and the process that started pytest survives to give the verdict. What is guaran
   ``report.html`` count it like any failure; pytest-xdist starts a new worker for the other checks.
 * **One crash per scene.** A check that would run a crashed scene with the same sync again fails at once,
   naming the crash, instead of crashing another worker (:class:`~conformance.errors.SyncCrashed`): so
-  a sync that crashes everywhere costs one worker start per scene, and xdist's limit on restarts is
-  raised to cover every scene.
+  a sync that crashes everywhere costs one worker start per scene (under ``-n``, one per worker that was
+  already running one of that scene's checks), and xdist's limit on restarts is raised to cover every scene.
 * Nothing is left behind: a worker's Xvfb dies with it (:mod:`conformance.display`), and the crash files
   live in a temporary directory the controller removes at the end.
 """
