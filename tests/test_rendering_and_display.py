@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import sys
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -206,40 +208,58 @@ def test_a_driver_that_can_start_still_renders(tmp_path, variables):
     assert (np.asarray(Image.open(out)) != 255).any(), "the picture is blank: nothing was drawn"
 
 
+# The tests below change driver variables in a child of their own, never in this process's environment:
+# the kit's background runs (tests/background.py) start processes from it at any moment of the session.
+
+def _child(tmp_path, code: str, **variables) -> str:
+    """Run ``code`` in a fresh Python with ``variables``; what it printed (it must exit 0)."""
+    done = _run(["-c", textwrap.dedent(code)], tmp_path, **variables)
+    assert done.returncode == 0, _said(done)
+    return done.stdout.strip().splitlines()[-1]
+
+
 @vtk_only
-def test_an_opengl_older_than_3_2_is_refused_too(monkeypatch):
+def test_an_opengl_older_than_3_2_is_refused_too(tmp_path):
     """VTK neither aborts nor draws here: it logs an error and goes on."""
-    from conformance import renderer_start
-
-    display.ensure_display()
-    monkeypatch.setenv("MESA_GL_VERSION_OVERRIDE", "3.0")
-    with pytest.raises(DisplayUnavailable, match=r"MESA_GL_VERSION_OVERRIDE='3\.0'.*exited with status 1, saying: "
-                       r".*VTK found no OpenGL 3\.2 or later.* To fix it, unset MESA_GL_VERSION_OVERRIDE") as raised:
-        renderer_start.check_gl()
-    assert "\n" not in str(raised.value)
-
-
-def test_the_probe_runs_once_per_process_and_environment(monkeypatch):
-    from conformance import renderer_start
-
-    answers = iter([None, "the paragraph"])
-    probes = []
-    monkeypatch.setattr(renderer_start, "_answers", {})
-    monkeypatch.setattr(renderer_start, "_probe", lambda: probes.append(1) or next(answers))
-    monkeypatch.delenv(renderer_start.PROBED_VARIABLE, raising=False)
-    monkeypatch.delenv("GALLIUM_DRIVER", raising=False)
-    renderer_start.check_gl()
-    renderer_start.check_gl()
-    assert len(probes) == 1
-    monkeypatch.setenv("GALLIUM_DRIVER", "zink")  # another environment: asked again, and the error kept
-    for _ in range(2):
-        with pytest.raises(DisplayUnavailable, match="the paragraph"):
+    said = _child(tmp_path, """
+        from conformance import display, renderer_start
+        from conformance.errors import DisplayUnavailable
+        display.ensure_display()
+        try:
             renderer_start.check_gl()
-    assert len(probes) == 2
-    monkeypatch.delenv("GALLIUM_DRIVER")
-    monkeypatch.setattr(renderer_start, "_answers", {})  # a child process, which inherits the parent's pass
-    renderer_start.check_gl()
-    assert len(probes) == 2
+        except DisplayUnavailable as refused:
+            print("refused:", str(refused).replace("\\n", "<newline>"))
+    """, MESA_GL_VERSION_OVERRIDE="3.0")
+    assert re.match(r"refused: .*MESA_GL_VERSION_OVERRIDE='3\.0'.*exited with status 1, saying: .*VTK found no OpenGL "
+                    r"3\.2 or later.* To fix it, unset MESA_GL_VERSION_OVERRIDE", said), said
+    assert "<newline>" not in said
+
+
+def test_the_probe_runs_once_per_process_and_environment(tmp_path):
+    assert _child(tmp_path, """
+        import os
+        from conformance import renderer_start
+        from conformance.errors import DisplayUnavailable
+
+        answers, probes = iter([None, "the paragraph"]), []
+        renderer_start._probe = lambda: probes.append(1) or next(answers)
+        renderer_start.check_gl()
+        renderer_start.check_gl()
+        assert len(probes) == 1, probes
+        os.environ["GALLIUM_DRIVER"] = "zink"  # another environment: asked again, and the error kept
+        for _ in range(2):
+            try:
+                renderer_start.check_gl()
+                raise SystemExit("check_gl passed, but should raise the paragraph")
+            except DisplayUnavailable as refused:
+                assert str(refused) == "the paragraph", refused
+        assert len(probes) == 2, probes
+        del os.environ["GALLIUM_DRIVER"]
+        renderer_start._answers.clear()  # as in a child process, which inherits the parent's pass
+        renderer_start.check_gl()
+        assert len(probes) == 2, probes
+        print("ok")
+    """) == "ok"
 
 
 def test_what_the_child_said_is_one_line_without_vtks_log_prefix():
@@ -253,16 +273,14 @@ def test_what_the_child_said_is_one_line_without_vtks_log_prefix():
 
 
 @vtk_only
-def test_an_app_whose_driver_cannot_start_gets_the_paragraph(monkeypatch):
+def test_an_app_whose_driver_cannot_start_gets_the_paragraph(tmp_path):
     """App mode: the app's own process probes before the app makes its window, which would abort it."""
-    from conformance import renderer_start
-    from conformance.apps import launch
-
-    for name in renderer_start.GL_VARIABLES:
-        monkeypatch.delenv(name, raising=False)
-    monkeypatch.setenv("GALLIUM_DRIVER", "zink")
-    with pytest.raises(launch.AppFailed) as raised:
-        launch.record(Path(__file__).parent / "apps" / "box_vtk.py", ticks=2)
-    message = str(raised.value)
+    message = _child(tmp_path, f"""
+        from conformance.apps import launch
+        try:
+            launch.record({str(Path(__file__).parent / "apps" / "box_vtk.py")!r}, ticks=2)
+        except launch.AppFailed as failed:
+            print(str(failed).replace("\\n", "<newline>"))
+    """, GALLIUM_DRIVER="zink")
     assert "box_vtk.py: VTK cannot start its OpenGL renderer" in message and "GALLIUM_DRIVER='zink'" in message
-    assert "unset GALLIUM_DRIVER" in message and "\n" not in message
+    assert "unset GALLIUM_DRIVER" in message and "<newline>" not in message
