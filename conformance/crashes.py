@@ -40,7 +40,8 @@ import pytest
 
 from conformance.errors import SyncCrashed
 
-__all__ = ["CHOICES", "Controller", "Journal", "arrange", "check_not_crashed", "noting"]
+__all__ = ["CHOICES", "Controller", "Journal", "allow_restarts", "arrange", "at", "check_not_crashed", "noting",
+           "start_journal"]
 
 CHOICES = ("auto", "process", "none")
 _INPUT_KEY = "conformance_crash_dir"
