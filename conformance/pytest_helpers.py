@@ -30,6 +30,7 @@ __all__ = [
     "assert_geometry_matches",
     "assert_vertices_match",
     "bounds_figure",
+    "each_golden_variant",
     "each_scene",
     "reproduce_command",
     "sync_run",
@@ -41,6 +42,23 @@ def each_scene(argname: str = "scene_name", origin: str | None = None, only: Seq
     ``scene`` mark each, so ``-k chain`` selects a scene and the verdict table groups by scene."""
     names = [n for n in scenes.names(origin) if only is None or n in only]
     return pytest.mark.parametrize(argname, [pytest.param(n, id=n, marks=pytest.mark.scene(n)) for n in names])
+
+
+def variant_id(params: Mapping[str, Any]) -> str:
+    """A golden variant's part of a pytest id: ``by_kind`` for ``grouping='by_kind'``, ``shared`` for
+    ``shared=True``."""
+    return "-".join(k if v is True else str(v) for k, v in params.items())
+
+
+def each_golden_variant(argnames: str = "scene_name, variant"):
+    """Parametrize a golden check over every scene (``variant={}``) and each of its golden variants
+    (``SceneSpec.golden_variants``, ids such as ``mixed_shapes-by_kind``), all marked with the scene."""
+    params = []
+    for name in scenes.names():
+        params.append(pytest.param(name, {}, id=name, marks=pytest.mark.scene(name)))
+        params += [pytest.param(name, dict(v), id=f"{name}-{variant_id(v)}", marks=pytest.mark.scene(name))
+                   for v in scenes.get(name).golden_variants]
+    return pytest.mark.parametrize(argnames, params)
 
 
 def reproduce_command(scene: str, sync: str, frames: int, params: Mapping[str, Any], events: Sequence = ()) -> str:

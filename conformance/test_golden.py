@@ -9,6 +9,9 @@ holding the physics state of that frame. Each golden gets two verdicts, reported
   It judges the sync and the renderer, independent of any drift in physics. The frames are restored
   in order in one run, so data changed without telling the renderer, a frame drawn late, recoloured bodies or
   a moved camera all show.
+  A scene's golden variants (``SceneSpec.golden_variants``: the same bodies grouped into shared
+  actors, e.g. ``test_golden_render[mixed_shapes-by_kind]``) are judged against the same goldens:
+  grouping changes how a sync must write and announce, never what the picture shows.
 * ``test_golden_physics``: the live run's state at each golden frame against the stored one: a
   failure here is pyBullet or the platform, not rendering. Past a scene's chaotic step (the wrecking
   ball's whip) a difference is reported as a warning, not hidden and not failed.
@@ -23,48 +26,52 @@ import pytest
 
 from conformance import scenes
 from conformance.errors import GoldenError
-from conformance.pytest_helpers import each_scene
+from conformance.pytest_helpers import each_golden_variant, each_scene, variant_id
 
 
-def _reproduce(check: str, scene: str, sync: str) -> str:
+def _reproduce(check: str, scene: str, sync: str, variant: dict | None = None) -> str:
     from conformance import own_scenes
 
     source = own_scenes.scene_arguments(scene)[1:]
-    return shlex.join(["pytest", "--pyargs", "conformance", "-k", f"{check} and {scene}", "--sync", sync,
+    # The whole id, brackets included: "mixed_shapes" alone would select its variants' checks too.
+    selected = f"{check}[{scene}-{variant_id(variant)}]" if variant else f"{check}[{scene}]"
+    return shlex.join(["pytest", "--pyargs", "conformance", "-k", selected, "--sync", sync,
                        *(["--conformance-scenes", *source] if source else [])])
 
 
-def _goldens(pictures, scene):
+def _goldens(pictures, scene, params=None):
     from conformance.rendering import snapshots
 
     try:
-        return {frame: snapshots.load(pictures.golden_dir_for(scene.name), scene, frame)
+        return {frame: snapshots.load(pictures.golden_dir_for(scene.name), scene, frame, params=params)
                 for frame in scenes.get(scene.name).frames_with_goldens()}
     except GoldenError as err:
         pytest.fail(str(err), pytrace=False)
 
 
-@each_scene()
-def test_golden_render(scene_name, kit, pictures, request):
-    """Each golden frame, restored and drawn by the sync under test, renders as the golden within tolerance."""
+@each_golden_variant()
+def test_golden_render(scene_name, variant, kit, pictures, request):
+    """Each golden frame, restored and drawn by the sync under test, renders as the golden within
+    tolerance; in a golden variant, drawn through the variant's shared actors."""
     from conformance.rendering import snapshots
 
-    if pictures.regen:
+    if pictures.regen and not variant:  # a variant has no goldens of its own to make
         pictures.note_regenerated(request.node, snapshots.regenerate(scene_name, pictures.golden_dir_for(scene_name)))
     failures = []
-    with kit.run(scene_name) as run:
-        goldens = _goldens(pictures, run.scene)
+    with kit.run(scene_name, **variant) as run:
+        goldens = _goldens(pictures, run.scene, scenes.get(scene_name).defaults)
         physics = {v.frame: v for v in snapshots.check_physics(scene_name, goldens)}
         for frame, golden in goldens.items():
             record, images = snapshots.check_render(run, golden, pictures.tolerance_for(golden), sync=kit.sync)
             record.details["physics"] = physics[frame].as_dict()
-            record.reproduce = _reproduce("test_golden_render", scene_name, kit.sync)
+            record.reproduce = _reproduce("test_golden_render", scene_name, kit.sync, variant)
             record.nodeid = request.node.nodeid
             pictures.keep(record, images)
             if not record.passed:
                 failures.append(record)
     if failures:
-        lines = [f"{r.message} [{scene_name}, frame {r.frame}, sync {kit.sync!r}]" for r in failures]
+        where = f"{scene_name}({', '.join(f'{k}={v!r}' for k, v in variant.items())})" if variant else scene_name
+        lines = [f"{r.message} [{where}, frame {r.frame}, sync {kit.sync!r}]" for r in failures]
         lines.append(f"pictures: {pictures.results} (report.html); reproduce: {failures[0].reproduce}")
         pytest.fail("\n".join(lines), pytrace=False)
 

@@ -62,17 +62,24 @@ class SceneSpec:
     #: Parameter sets the property-based checks always try, besides the defaults: the variants that
     #: exercise a different drawing path (e.g. shared actors) and must not be left to chance.
     examples: tuple[Mapping[str, Any], ...] = ()
+    #: Parameter sets that draw the default picture another way (bodies sharing one actor, their
+    #: vertices rewritten): each gets the golden render verdict against the default goldens, so what a
+    #: sync fails to upload from a shared actor shows in a picture. A variant may change how bodies are
+    #: grouped into actors, never a body or its pose: its reference picture must be the default's
+    #: within the same-renderer tolerance (``tests/test_golden_variants.py`` keeps that true).
+    golden_variants: tuple[Mapping[str, Any], ...] = ()
     defaults: Mapping[str, Any] = field(init=False)
 
     def __post_init__(self):
         params = inspect.signature(self.populate).parameters.values()
         defaults = {p.name: p.default for p in params if p.kind is inspect.Parameter.KEYWORD_ONLY}
         object.__setattr__(self, "defaults", defaults)
-        for example in self.examples:
-            unknown = sorted(set(example) - set(defaults))
-            if unknown:
-                raise InvalidArgument(f"SceneSpec {self.name!r}: examples has {example!r}, but "
-                                      f"{', '.join(map(repr, unknown))} is not a parameter of its populate()")
+        for argument in ("examples", "golden_variants"):
+            for example in getattr(self, argument):
+                unknown = sorted(set(example) - set(defaults))
+                if unknown:
+                    raise InvalidArgument(f"SceneSpec {self.name!r}: {argument} has {example!r}, but "
+                                          f"{', '.join(map(repr, unknown))} is not a parameter of its populate()")
 
     def frames_with_goldens(self) -> tuple[int, ...]:
         if self.golden_frames is not None:

@@ -86,10 +86,11 @@ def make(scene_name: str) -> list[tuple[int, np.ndarray, dict[str, Any]]]:
     return made
 
 
-def load(directory: Path | str, scene, frame: int) -> storage.Golden:
-    """The golden of a built scene at ``frame``, validated against its parameters, camera and size."""
-    return storage.read(directory, scene.name, frame, params=dict(scene.params), camera=scene.camera.as_dict(),
-                        size=tuple(scene.image_size))
+def load(directory: Path | str, scene, frame: int, params=None) -> storage.Golden:
+    """The golden of a built scene at ``frame``, validated against its parameters (or ``params``: a
+    golden variant's are the default scene's), camera and size."""
+    return storage.read(directory, scene.name, frame, params=dict(scene.params if params is None else params),
+                        camera=scene.camera.as_dict(), size=tuple(scene.image_size))
 
 
 def check_render(run, golden: storage.Golden, tolerance, *, sync: str) -> tuple[ImageCheck, dict[str, np.ndarray]]:
