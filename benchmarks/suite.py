@@ -11,6 +11,9 @@ wall clock; they take minutes, so by default each is run once (``--suite-repeats
   the reference sync;
 * ``pytest conformance --sync wrong_syncs:OneStepLate``, serial: a wrong sync's full verdict (it fails
   about a third of the checks, on every scene), to hold against the right one's (:data:`WRONG`);
+* ``pytest conformance --sync right_syncs:PerTargetSync``, serial, isolated (the default for a user's
+  sync: the run goes to one pytest-xdist worker, so a crash is a verdict) and with
+  ``--conformance-isolation none`` (in process): what crash isolation costs (:data:`ISOLATED`);
 * ``./kit test``: what CI runs, the kit's own tests and the checks (profile ``ci``).
 
 ``checks_only`` leaves out ``./kit test`` (half an hour on this machine), for the runs of the
@@ -31,7 +34,8 @@ from conformance import scenes
 
 from .timing import Candidate, RatioToBaseline, race, timed
 
-__all__ = ["BASELINE", "RIGHT", "ROOT", "WRONG", "SuiteFigure", "commands", "measure", "physics_of_every_scene"]
+__all__ = ["BASELINE", "IN_PROCESS", "ISOLATED", "RIGHT", "ROOT", "WRONG", "SuiteFigure", "commands", "measure",
+           "physics_of_every_scene"]
 
 ROOT = Path(__file__).resolve().parent.parent
 BASELINE = "the physics of every reference scene once (build + every step, in process)"
@@ -39,6 +43,10 @@ BASELINE = "the physics of every reference scene once (build + every step, in pr
 RIGHT = "`pytest conformance`"
 WRONG_SYNC = "wrong_syncs:OneStepLate"
 WRONG = f"`pytest conformance --sync {WRONG_SYNC}`"
+#: A right sync of the user's (not a short name, so isolated by default), isolated and in process.
+USER_SYNC = "right_syncs:PerTargetSync"
+ISOLATED = f"`pytest conformance --sync {USER_SYNC}` (isolated)"
+IN_PROCESS = f"`pytest conformance --sync {USER_SYNC} --conformance-isolation none`"
 
 
 @dataclass(frozen=True)
@@ -63,6 +71,8 @@ def commands(python: str = sys.executable, *, checks_only: bool = False) -> list
         (RIGHT, pytest),
         ("`pytest conformance -n 2`", pytest + ["-n", "2"]),
         (WRONG, pytest + ["--sync", WRONG_SYNC]),
+        (ISOLATED, pytest + ["--sync", USER_SYNC]),
+        (IN_PROCESS, pytest + ["--sync", USER_SYNC, "--conformance-isolation", "none"]),
         ("`./kit test`", [str(ROOT / "kit"), "test", "-q"]),
     ]
     return runs[:-1] if checks_only else runs

@@ -109,6 +109,10 @@ def evaluate(figures: Sequence[SyncFigure], subject: str, limits: Limits = Limit
 #: A wrong sync's full serial run may take at most this many times the reference's.
 WRONG_OVER_RIGHT = 1.5
 
+#: A user's sync run isolated (one pytest-xdist worker: a crash is a verdict) may take at most this many
+#: times the same run in process: isolation is a fixed start-up cost (about 2 s measured on a 39-check subset).
+ISOLATED_OVER_IN_PROCESS = 1.1
+
 #: Whole runs and the wall time each should stay within, in seconds.
 SUITE_LIMITS = {"`pytest conformance`": 90.0, "`pytest conformance -n 2`": 60.0, "`./kit test`": 300.0}
 
@@ -123,9 +127,16 @@ def evaluate_suite(figures) -> list[Verdict]:
         measured = f"{figure.seconds:.1f} s" + ("" if figure.returncode == 0 else f", exit {figure.returncode}")
         verdicts.append(Verdict(f"{figure.name} within {limit:g} s, exit 0", measured,
                                 figure.seconds <= limit and figure.returncode == 0))
-    from .suite import RIGHT, WRONG
+    from .suite import IN_PROCESS, ISOLATED, RIGHT, WRONG
 
     by = {f.name: f for f in figures}
+    if ISOLATED in by and IN_PROCESS in by:
+        isolated, in_process = by[ISOLATED], by[IN_PROCESS]
+        ratio = isolated.seconds / in_process.seconds if in_process.seconds > 0 else float("inf")
+        verdicts.append(Verdict(f"crash isolation: {ISOLATED} within {ISOLATED_OVER_IN_PROCESS:g}× the run in process, exit 0",
+                                f"{ratio:.2f}× ({isolated.seconds:.1f} s against {in_process.seconds:.1f} s, "
+                                f"exit {isolated.returncode} and {in_process.returncode})",
+                                ratio <= ISOLATED_OVER_IN_PROCESS and isolated.returncode == 0 == in_process.returncode))
     if RIGHT in by and WRONG in by:
         right, wrong = by[RIGHT], by[WRONG]
         ratio = wrong.seconds / right.seconds if right.seconds > 0 else float("inf")

@@ -254,8 +254,9 @@ def test_whole_runs_are_timed_with_their_exit_status_and_tabled():
     text = report.markdown(Results(options=Options(parts=()), machine=_machine(), started="now", suite=figures))
     assert "**Whole runs**" in text and "| fails |" in text and "| 3 |" in text and "| 2 of 9 |" in text
     assert [name for name, _ in suite.commands()] == ["`pytest --collect-only conformance`", "`pytest conformance`",
-                                                      "`pytest conformance -n 2`", suite.WRONG, "`./kit test`"]
-    assert [name for name, _ in suite.commands(checks_only=True)][-1] == suite.WRONG
+                                                      "`pytest conformance -n 2`", suite.WRONG, suite.ISOLATED,
+                                                      suite.IN_PROCESS, "`./kit test`"]
+    assert [name for name, _ in suite.commands(checks_only=True)][-1] == suite.IN_PROCESS
 
 
 def test_whole_runs_pass_their_time_limits_only_in_time_and_with_exit_0():
@@ -281,6 +282,17 @@ def test_a_wrong_syncs_full_run_is_judged_against_the_right_ones():
     assert verdict(100.0, 140.0).passed and "1.40× (140 s against 100 s, 97 of 295 checks failed, exit 1)" in verdict(100.0, 140.0).measured
     assert not verdict(100.0, 160.0).passed, "over 1.5×"
     assert not verdict(100.0, 90.0, wrong_exit=0).passed, "a wrong sync that passes is no verdict"
+
+
+def test_crash_isolation_is_judged_against_the_same_run_in_process():
+    def verdict(isolated, in_process, exit_code=0):
+        figures = [suite.SuiteFigure(suite.ISOLATED, command="…", baseline=1.0, seconds=isolated, returncode=exit_code),
+                   suite.SuiteFigure(suite.IN_PROCESS, command="…", baseline=1.0, seconds=in_process)]
+        return [v for v in targets.evaluate_suite(figures) if "crash isolation" in v.target][0]
+
+    assert verdict(82.0, 80.0).passed and "1.02× (82.0 s against 80.0 s, exit 0 and 0)" in verdict(82.0, 80.0).measured
+    assert not verdict(90.0, 80.0).passed, "over 1.1×"
+    assert not verdict(81.0, 80.0, exit_code=1).passed, "a right sync failing isolated is no measurement"
 
 
 def _machine():
