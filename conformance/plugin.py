@@ -148,11 +148,12 @@ def app_paths(config: pytest.Config) -> list:
     if not patterns:
         return []
     from conformance import backends
+    from conformance.apps.mapping import SUFFIX  # an app's mapping beside it is not an app
 
     found = []
     for pattern in patterns:
         pattern = pattern.replace("{backend}", backends.NAME)
-        matches = sorted(p for p in config.rootpath.glob(pattern) if p.is_file())
+        matches = sorted(p for p in config.rootpath.glob(pattern) if p.is_file() and not p.name.endswith(SUFFIX))
         if not matches:
             raise pytest.UsageError(f"ini conformance_apps: {pattern!r} matches no file under {config.rootpath}")
         found.extend(matches)

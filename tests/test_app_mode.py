@@ -93,9 +93,13 @@ def test_an_app_raising_in_its_callback_fails_runs(tmp_path):
 
 def test_apps_in_the_ini_are_checked_one_id_per_check(pytester):
     pytester.makefile(".py", app=SOURCE)
+    # The app's mapping beside it is matched by the glob, and is not an app.
+    actor, body = ("ball_actor", "ball") if backends.NAME == "vtk" else ("box", "body")
+    (pytester.path / "app.mapping.py").write_text(f"from conformance.apps.mapping import Draws\n\n"
+                                                  f"def mapping(app):\n    return [Draws(app.{actor}, app.{body})]\n")
     pytester.makeini(textwrap.dedent("""\
         [pytest]
-        conformance_apps = app.py
+        conformance_apps = *.py
         conformance_app_ticks = 20
     """))
     result = pytester.runpytest_subprocess("--pyargs", "conformance.test_apps", "-p", "no:cacheprovider",
@@ -108,3 +112,28 @@ def test_a_missing_app_is_a_usage_error(pytester):
     result = pytester.runpytest_subprocess("--pyargs", "conformance.test_apps", "--conformance-app", "nowhere.py")
     assert result.ret == pytest.ExitCode.USAGE_ERROR
     result.stderr.fnmatch_lines(["*--conformance-app='nowhere.py': no such file*"])
+
+
+SPHERES = Path(__file__).parent / "apps" / "spheres_pygfx.py"
+ANNOUNCE_NORMALS = "        balls.geometry.normals.update_range(i * sec, sec)\n"
+ANNOUNCE_POSITIONS = "        balls.geometry.positions.update_range(i * sec, sec)\n"
+
+
+@pytest.mark.skipif(backends.NAME != "pygfx", reason="pygfx uploads each buffer's announced ranges alone; FURY 0.12's "
+                    "one Modified() re-uploads all of the geometry, which the box app's copies cover")
+@pytest.mark.parametrize("change, needle", [
+    (lambda s: s, None),
+    (lambda s: s.replace(ANNOUNCE_NORMALS, ""), r"at tick 1 its normals changed at vertices 0–\d+ \(\d+ of them\), with nothing announced"),
+    (lambda s: s.replace(ANNOUNCE_POSITIONS, "").replace(ANNOUNCE_NORMALS, ANNOUNCE_NORMALS + "    balls.geometry.positions"
+                                                        ".update_range(i * sec, sec)\n"),
+     r"at tick 1 its positions changed at vertices 0–\d+ \(\d+ of them\), outside every range announced"),
+])
+def test_every_buffer_and_range_an_app_changes_is_announced(tmp_path, change, needle):
+    import re
+
+    text = change(SPHERES.read_text(encoding="utf-8"))
+    verdict = apps.check_app(_copy(tmp_path, text), ticks=20).verdicts["announced"]
+    if needle is None:
+        assert verdict.passed, verdict.message()
+    else:
+        assert not verdict.passed and re.search(needle, verdict.message()), verdict.message()

@@ -39,6 +39,7 @@ def main(argv=None) -> int:
 
     from conformance import backends
     from conformance.apps import driver as app_driver, perturb, recording
+    from conformance.apps.mapping import MappingError
 
     name = backends.NAME
     if name == "vtk":
@@ -68,7 +69,7 @@ def main(argv=None) -> int:
     except SystemExit as exc:
         if exc.code not in (None, 0) and driver.recording is None:
             return _fail(args.out, f"{args.script}: the app exited with status {exc.code} before its loop ran.")
-    except app_driver.AppLoopNotFound as err:
+    except (app_driver.AppLoopNotFound, MappingError) as err:
         return _fail(args.out, str(err))
     except Exception as exc:
         if driver.recording is None:

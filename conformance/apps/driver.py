@@ -27,7 +27,7 @@ from types import SimpleNamespace
 import numpy as np
 import pybullet
 
-from conformance.apps import bodies
+from conformance.apps import bodies, mapping
 from conformance.apps.recording import ActorTrack, Recording
 from conformance.errors import ConformanceError
 
@@ -203,6 +203,8 @@ class Driver:
         self._frames = bodies.frames_of(clients)
         names = _labels(actors)
         tracks = [_Track(a, names.get(id(a)) or f"actor #{i}", self._backend) for i, a in enumerate(actors)]
+        mapped = mapping.resolve(self.script, sys.modules.get("__main__"), actors, names,
+                                 [len(self._backend.world_vertices(a)) for a in actors], self._frames, clients)
         end_pos, end_orn, before_pos, before_orn, steps = [], [], [], [], []
         nowhere = np.full((len(self._frames), 26), np.nan)
         writes, writers = [], []
@@ -256,7 +258,7 @@ class Driver:
             before_positions=np.array(before_pos), before_orientations=np.array(before_orn),
             steps=np.array(steps, dtype=np.int64), loop=f"{source.describe()} (handed over at {self.entry or 'the end of the script'})",
             ended=ended, events=[perturb.as_dict(e) for e in self.events], notes=notes,
-            writes=np.array(writes), writers=writers,
+            writes=np.array(writes), writers=writers, mapping=mapped,
             seconds={"app": in_ticks - self._reading, "record": in_snapshots + self._reading})
 
 
@@ -269,6 +271,7 @@ class _Track:
         self.normals: list[np.ndarray] = []
         self.changed: list[bool] = []
         self.announced: list[bool] = []
+        self.missed: list[tuple[int, str]] = []
         self._state = None
 
     def snapshot(self) -> None:
@@ -283,6 +286,11 @@ class _Track:
         else:
             self.changed.append(state[1] != self._state[1])
             self.announced.append(state[0] != self._state[0])
+            # Buffer by buffer and range by range where the renderer uploads that way (FURY 2): read
+            # before the hand-over below takes the tick's announced ranges.
+            missed = self.backend.unannounced(self.actor, self._state, state) if self.changed[-1] else None
+            if missed:
+                self.missed.append((len(self.changed) - 1, missed))
         self._state = state
         self.backend.hand_over(self.actor)  # as the window's next frame would, so the next tick starts clean
 
@@ -290,7 +298,7 @@ class _Track:
         kind = type(self.actor).__name__
         normals = np.array(self.normals) if len(self.normals) == ticks else None
         return ActorTrack(self.label, kind, np.array(self.vertices), normals,
-                          np.array(self.changed), np.array(self.announced))
+                          np.array(self.changed), np.array(self.announced), list(self.missed))
 
 
 def install_pybullet(driver: Driver) -> None:

@@ -44,7 +44,8 @@ DIAGNOSES = {name: text for name, (text, _) in attach_mod.VARIANTS.items()} | {
     "turned-shape": "the actor was built turned in its body's frame (a box's directions, a cylinder's axis)",
     "stale-normals": "the vertices turn but the stored normals do not: turn normals with the same rotation",
     "unannounced": "vertex data changed without telling the renderer, which keeps drawing the old data: call "
-                   "utils.update_actor (FURY 0.12) or positions.update_range/update_full (FURY 2)",
+                   "utils.update_actor (FURY 0.12); on FURY 2 call update_range (or update_full) on every buffer "
+                   "changed, positions and normals, covering each changed range",
     "written-back": "the pose that was drawn (as read, or rounded to float32) is written back into pyBullet "
                     "(\"so physics and graphics agree\"): resetBasePositionAndOrientation also sets the body's "
                     "velocity to zero (pybullet 3.2.7), so the simulation is changed; a sync only reads",
@@ -82,8 +83,29 @@ class _Judgement:
                                               event_ticks=self.event_ticks, centres=centres, radii=radii)
                             for a in recording.actors] \
             if recording.ticks else []
+        self.mapped = [np.zeros(len(a.frame), dtype=bool) for a in self.attachments]
+        for entry in recording.mapping:
+            self._apply_mapping(entry)
         self.followed_badly: set[int] = set()
         self._attached_done = False
+
+    def _apply_mapping(self, entry: dict) -> None:
+        """Judge the mapped vertices in the frame the mapping names, not the one that holds them best:
+        every later check (held, placed, drawn, normals) then reads the mapping's frame for them."""
+        a, frame = self.attachments[entry["actor"]], int(entry["frame"])
+        rows = slice(entry["start"], entry["stop"])
+        vertices = self.r.actors[entry["actor"]].vertices[1:, rows]
+        error, allowance = self._errors(vertices, frame)
+        a.frame[rows], a.error[rows], a.allowance[rows], a.tied[rows] = frame, error, allowance, False
+        a.reference[rows] = self._reference(vertices, frame)
+        a.__dict__.pop("held", None)  # computed from the errors just replaced
+        self.mapped[entry["actor"]][rows] = True
+
+    def _reference(self, vertices, frame: int) -> np.ndarray:
+        """Median coordinates ``(m, 3)`` of vertices ``(T, m, 3)`` in ``frame``."""
+        pos, rot = attach_mod._world(self.pos, self.rot)
+        f = np.full(vertices.shape[1], frame if frame >= 0 else pos.shape[1] - 1)
+        return np.median(attach_mod.local_coordinates(vertices, pos[:, f], rot[:, f]), axis=0)
 
     def frame_label(self, index: int) -> str:
         return "the world" if index < 0 else self.r.frames[index].label
@@ -104,10 +126,10 @@ class _Judgement:
         self.followed_badly.clear()
         verdict = Verdict("attached", True)
         worst = 0.0
-        for track, a in zip(self.r.actors, self.attachments):
+        for track, a, mapped in zip(self.r.actors, self.attachments, self.mapped):
             ratio = a.error / a.allowance[:, None]
             worst = max(worst, float(ratio.max(initial=0)))
-            loose = ~a.held
+            loose = ~a.held & ~mapped
             tied = int(a.tied.sum())
             if tied:
                 verdict.notes.append(f"{track.label}: {tied} vertices are held equally by two frames that never moved "
@@ -128,8 +150,37 @@ class _Judgement:
                 if diagnosis:
                     verdict.lines.append(f"    diagnosis: {DIAGNOSES[diagnosis]}")
                     verdict.diagnoses.append(diagnosis)
+        for entry in self.r.mapping:
+            self._judge_mapped(entry, verdict)
         verdict.worst = worst
         return verdict
+
+    def _judge_mapped(self, entry: dict, verdict: Verdict) -> None:
+        """Mapped vertices are held by the very frame the mapping names at every tick."""
+        track, a, frame = self.r.actors[entry["actor"]], self.attachments[entry["actor"]], int(entry["frame"])
+        rows = np.arange(entry["start"], entry["stop"])
+        if a.held[rows].all():
+            return
+        verdict.passed = False
+        self.followed_badly.add(frame)
+        error, allowance = a.error[rows], a.allowance[rows]
+        bad_ticks = np.flatnonzero(np.any(error > allowance[:, None], axis=0))
+        first, k = int(bad_ticks[0]), int(np.argmax(error.max(axis=0)))
+        vertices = track.vertices[1:, rows]
+        diagnosis = self._diagnose(vertices, frame, a.reference[rows], allowance, bad_ticks)
+        line = (f"{track.label} ({track.kind}) vertices {rows[0]}:{rows[-1] + 1}, drawn for {self.frame_label(frame)} "
+                f"by the app's mapping: not held by it from tick {first + 1}: {error[:, first].max():.3g} m from where "
+                f"it carries them (allowed {allowance.max():.3g} m); worst {error[:, k].max():.3g} m at tick {k + 1}")
+        if not diagnosis:
+            other, _ = self._followed(vertices, np.full(len(rows), -1), a.reference[rows])
+            held, _ = self._errors(vertices, other)
+            if other >= 0 and other != frame and np.all(held <= allowance[:, None]):
+                line += f"; they are held by {self.frame_label(other)} instead"
+                diagnosis = "other-body"
+        verdict.lines.append(line)
+        if diagnosis:
+            verdict.lines.append(f"    diagnosis: {DIAGNOSES[diagnosis]}")
+            verdict.diagnoses.append(diagnosis)
 
     def _loose_pieces(self, track, a, loose):
         """``(start, stop, frame, diagnosis)`` of the actor's loose vertices, one per body or link they were
@@ -325,11 +376,15 @@ class _Judgement:
     def announced(self) -> Verdict:
         verdict = Verdict("announced", True)
         for track in self.r.actors:
-            silent = np.flatnonzero(track.changed[1:] & ~track.announced[1:])
-            if len(silent):
+            # A change with nothing announced, or (FURY 2, buffer by buffer) outside what was announced.
+            silent = sorted(set((np.flatnonzero(track.changed[1:] & ~track.announced[1:]) + 1).tolist())
+                            | {tick for tick, _ in track.missed})
+            if silent:
                 verdict.passed = False
-                verdict.lines.append(f"{track.label} ({track.kind}): its vertex data changed at tick {silent[0] + 1} "
-                                     f"({len(silent)} ticks in all) without being announced to the renderer")
+                words = dict(track.missed).get(silent[0])
+                what = (f"at tick {silent[0]} {words}" if words else
+                        f"its vertex data changed at tick {silent[0]} without being announced to the renderer")
+                verdict.lines.append(f"{track.label} ({track.kind}): {what} ({len(silent)} ticks in all)")
                 verdict.lines.append(f"    diagnosis: {DIAGNOSES['unannounced']}")
                 verdict.diagnoses.append("unannounced")
         return verdict

@@ -25,8 +25,10 @@ __all__ = ["ActorTrack", "Recording", "load", "save"]
 class ActorTrack:
     """One drawn actor: world vertices ``(T+1, n, 3)`` as the renderer draws them (through the actor's
     full matrix), its stored normals as lit ``(T+1, n, 3)`` or None, and per tick whether its vertex
-    data changed and whether the change was announced to the renderer (VTK ``Modified()``, pygfx
-    ``update_range``/``update_full``)."""
+    data changed and whether a change was announced to the renderer (VTK ``Modified()``, pygfx
+    ``update_range``/``update_full``); ``missed`` lists the ticks whose change will not all reach the
+    screen, with which buffer and vertices in words (pygfx uploads only the announced ranges of each
+    buffer, so a change announced on positions alone, or outside its ranges, is missed too)."""
 
     label: str
     kind: str
@@ -34,6 +36,7 @@ class ActorTrack:
     normals: np.ndarray | None
     changed: np.ndarray
     announced: np.ndarray
+    missed: list = field(default_factory=list)  # (tick, "its normals changed at vertices 0–287, …")
 
 
 @dataclass
@@ -64,6 +67,8 @@ class Recording:
     #: (NaN in ticks without such a write); None in recordings made without it
     writes: np.ndarray | None = None
     writers: list = field(default_factory=list)  # per tick, the names of the writing calls
+    #: the app's mapping (:mod:`conformance.apps.mapping`): {"actor", "start", "stop", "frame"} entries
+    mapping: list = field(default_factory=list)
 
     @property
     def ticks(self) -> int:
@@ -84,11 +89,13 @@ def save(recording: Recording, path) -> None:
         arrays[f"a{i}_announced"] = track.announced
         if track.normals is not None:
             arrays[f"a{i}_normals"] = track.normals
-        actors.append({"label": track.label, "kind": track.kind, "normals": track.normals is not None})
+        actors.append({"label": track.label, "kind": track.kind, "normals": track.normals is not None,
+                       "missed": [list(m) for m in track.missed]})
     meta = {"script": recording.script, "backend": recording.backend, "actors": actors,
             "frames": [f.as_dict() for f in recording.frames], "loop": recording.loop, "ended": recording.ended,
             "events": recording.events, "notes": recording.notes,
-            "error": recording.error, "seconds": recording.seconds, "writers": recording.writers}
+            "error": recording.error, "seconds": recording.seconds, "writers": recording.writers,
+            "mapping": recording.mapping}
     arrays["meta"] = np.frombuffer(json.dumps(meta).encode("utf-8"), dtype=np.uint8)
     buffer = io.BytesIO()
     np.savez(buffer, **arrays)
@@ -107,10 +114,11 @@ def load(path) -> Recording:
         for i, a in enumerate(meta["actors"]):
             actors.append(ActorTrack(a["label"], a["kind"], data[f"a{i}_vertices"],
                                      data[f"a{i}_normals"] if a["normals"] else None,
-                                     data[f"a{i}_changed"], data[f"a{i}_announced"]))
+                                     data[f"a{i}_changed"], data[f"a{i}_announced"],
+                                     [(int(t), str(text)) for t, text in a.get("missed", [])]))
         return Recording(meta["script"], meta["backend"], actors, [_frame(f) for f in meta["frames"]],
                          data["positions"], data["orientations"], data["before_positions"],
                          data["before_orientations"], data["steps"], meta["loop"], meta["ended"],
                          meta["events"], meta["notes"], meta.get("error", ""),
                          meta.get("seconds", {}), data["writes"] if "writes" in data else None,
-                         meta.get("writers", []))
+                         meta.get("writers", []), meta.get("mapping", []))

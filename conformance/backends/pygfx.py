@@ -190,10 +190,13 @@ def content_time(actor) -> int:
     return max(b._rev for _, b in _buffers(actor))
 
 
-def content_state(actor) -> tuple[int, bytes]:
-    """The revision (:func:`content_time`) and a copy of the position and normal data, to tell a change
-    pygfx was told about from one it was not (pygfx uploads only announced ranges)."""
-    return content_time(actor), b"".join(bytes(memoryview(np.ascontiguousarray(b.data))) for _, b in _buffers(actor))
+def content_state(actor) -> tuple[int, bytes, tuple[int, ...]]:
+    """The revision (:func:`content_time`), a copy of the position and normal data and each buffer's
+    own revision, to tell a change pygfx was told about from one it was not (pygfx uploads only
+    announced ranges)."""
+    buffers = _buffers(actor)
+    return (max(b._rev for _, b in buffers), b"".join(bytes(memoryview(np.ascontiguousarray(b.data))) for _, b in buffers),
+            tuple(b._rev for _, b in buffers))
 
 
 def unannounced(actor, before: tuple[int, bytes], after: tuple[int, bytes]) -> str | None:
@@ -209,7 +212,8 @@ def unannounced(actor, before: tuple[int, bytes], after: tuple[int, bytes]) -> s
         stale = [name for name, b in buffers if b._chunks_dirt_flag != 2]
         return f"its {' and '.join(stale)} were replaced by buffers of another size, not announced whole" if stale else None
     offset = 0
-    for name, buffer in buffers:
+    revisions = before[2] if len(before) > 2 else (None,) * len(buffers)
+    for (name, buffer), revision in zip(buffers, revisions):
         size = np.asarray(buffer.data).nbytes
         was, now = old[offset:offset + size], new[offset:offset + size]
         offset += size
@@ -217,6 +221,10 @@ def unannounced(actor, before: tuple[int, bytes], after: tuple[int, bytes]) -> s
             continue
         changed = np.flatnonzero((np.frombuffer(was, np.uint8) != np.frombuffer(now, np.uint8))
                                  .reshape(max(buffer.nitems, 1), -1).any(axis=1))
+        if not buffer._chunks_dirt_flag and revision is not None and buffer._rev != revision:
+            # Announced, and already taken by a draw since ``before`` (an app that draws inside its own
+            # tick): the ranges are gone, so what was announced can no longer be told range by range.
+            continue
         if not buffer._chunks_dirt_flag or not buffer.nitems:
             return f"its {name} changed at {_vertices(changed)}, with nothing announced on them"
         missed = changed[~buffer._chunk_mask[changed // buffer._chunk_size]]

@@ -26,11 +26,13 @@ def add_arguments(parser) -> None:
 
 
 def example_paths(paths) -> list[Path]:
+    from conformance.apps.mapping import SUFFIX  # an app's mapping beside it is not an app
+
     found = []
     for given in paths:
         path = Path(given)
         if path.is_dir():
-            found += sorted(p for p in path.rglob("*.py") if not p.name.startswith("_"))
+            found += sorted(p for p in path.rglob("*.py") if not p.name.startswith("_") and not p.name.endswith(SUFFIX))
         elif path.is_file():
             found.append(path)
         else:
