@@ -15,6 +15,9 @@ holding the physics state of that frame. Each golden gets two verdicts, reported
 * ``test_golden_physics``: the live run's state at each golden frame against the stored one: a
   failure here is pyBullet or the platform, not rendering. Past a scene's chaotic step (the wrecking
   ball's whip) a difference is reported as a warning, not hidden and not failed.
+* ``test_no_stale_goldens``: every file in a golden directory is a golden some check reads; one no
+  check reads (a scene renamed or removed, a frame no longer golden) would pass for coverage it does
+  not give. ``python -m conformance regen --prune`` deletes exactly those.
 """
 
 from __future__ import annotations
@@ -95,3 +98,20 @@ def test_golden_physics(scene_name, pictures):
                               f"{v.difference.describe()}. The render verdict is unaffected (it restores the stored "
                               "state); this is pyBullet or the platform. If pyBullet changed on purpose: "
                               f"python -m conformance regen {scene_name}" for v in failed), pytrace=False)
+
+
+def test_no_stale_goldens(pictures):
+    """Every file in the golden directories of this run's scenes is a golden that a check reads."""
+    from conformance.rendering import golden
+
+    by_directory: dict = {}
+    for name in scenes.names():
+        by_directory.setdefault(pictures.golden_dir_for(name), {})[name] = scenes.get(name).frames_with_goldens()
+    found = [path for directory, wanted in by_directory.items() for path in golden.stale(directory, wanted)]
+    if found:
+        given = ["--golden-dir", str(pictures.golden_dir)] if pictures.golden_dir is not None else []
+        pytest.fail(f"{len(found)} file(s) in the golden directories are read by no check (a scene removed or renamed, "
+                    f"a frame no longer golden, a stray file): {', '.join(map(str, found[:20]))}"
+                    + (f" and {len(found) - 20} more" if len(found) > 20 else "")
+                    + f". Delete exactly those with: {shlex.join(['python', '-m', 'conformance', 'regen', '--prune', *given])}",
+                    pytrace=False)

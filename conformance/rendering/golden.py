@@ -27,15 +27,14 @@ import shlex
 import zlib
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterable
 
 import numpy as np
 
 from conformance.errors import GoldenMissing, GoldenUnreadable
 from conformance.files import encode_png, write_atomically
 
-__all__ = ["FORMAT", "Golden", "default_dir", "library_versions", "paths", "jsonable", "read", "regen_command",
-           "write", "encode_manifest"]
+__all__ = ["FORMAT", "Golden", "default_dir", "encode_manifest", "jsonable", "library_versions", "paths", "read", "regen_command", "stale", "write"]
 
 #: The manifest format; bumped when its meaning changes, so an old manifest is refused, not misread.
 FORMAT = 1
@@ -54,6 +53,17 @@ def paths(directory: Path | str, scene: str, frame: int) -> tuple[Path, Path]:
     """The PNG and manifest paths of ``scene`` at ``frame``."""
     base = Path(directory) / scene / f"frame-{frame:04d}"
     return base.with_suffix(".png"), base.with_suffix(".json")
+
+
+def stale(directory: Path | str, wanted: dict[str, Iterable[int]]) -> list[Path]:
+    """Every file under ``directory`` that no golden of ``wanted`` (scene → its golden frames) is: a
+    scene no longer registered, a frame no longer golden, a stray file. Nothing reads them, so a
+    committed one would pass for coverage it does not give."""
+    directory = Path(directory)
+    if not directory.is_dir():
+        return []
+    used = {p for scene, frames in wanted.items() for frame in frames for p in paths(directory, scene, frame)}
+    return sorted(p for p in directory.rglob("*") if p.is_file() and p not in used)
 
 
 def regen_command(scene: str, directory: Path | str | None = None) -> str:
