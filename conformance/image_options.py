@@ -17,7 +17,7 @@ import pytest
 
 from conformance.validation import DEFAULT_RESULTS
 
-__all__ = ["Pictures", "add_options", "from_config"]
+__all__ = ["Pictures", "add_options", "from_config", "golden_verdicts_summary"]
 
 _KEY = pytest.StashKey["Pictures"]()
 _REGENERATED = "conformance_golden_regenerated"
@@ -28,8 +28,10 @@ def add_options(group, parser) -> None:
                     help="directory of golden snapshots (default: the kit's own)")
     parser.addini("conformance_golden_dir", "default for --conformance-golden-dir", default=None)
     group.addoption("--conformance-image-tolerance", dest="conformance_image_tolerance", metavar="SET", default=None,
-                    help="image tolerance set: auto (same-renderer when a golden's manifest names this machine's "
-                    "renderer, else other-renderer), same-renderer or other-renderer. Default auto")
+                    help="image tolerance set: auto (the sync's render against a live reference render: same-renderer; "
+                    "the live reference against the golden: same-renderer when the golden's manifest names this machine's "
+                    "renderer or the pictures agree within it, else other-renderer), same-renderer or other-renderer "
+                    "(then both verdicts use it). Default auto")
     parser.addini("conformance_image_tolerance", "default for --conformance-image-tolerance", default=None)
     group.addoption("--conformance-results", dest="conformance_results", metavar="DIR", default=None,
                     help=f"where failure pictures, image-check records and report.html go (default {DEFAULT_RESULTS})")
@@ -70,10 +72,10 @@ class Pictures:
             self._renderer = backends.renderer_info()
         return self._renderer
 
-    def tolerance_for(self, golden):
-        from conformance.rendering import snapshots
-
-        return snapshots.tolerance_for(golden, self.renderer, None if self.tolerance == "auto" else self.tolerance)
+    @property
+    def override(self) -> str | None:
+        """The tolerance set asked for, or None for the automatic choice (:mod:`conformance.rendering.reftest`)."""
+        return None if self.tolerance == "auto" else self.tolerance
 
     def keep(self, record, images: dict[str, Any]) -> None:
         """Write a check's pictures (failures always; passes when asked) and its record."""
@@ -90,7 +92,8 @@ class Pictures:
     def describe(self) -> str:
         where = ("each scene's own (the kit's; yours in golden/ beside your scene file)" if self.golden_dir is None
                  else str(self.golden_dir))
-        tolerance = ("auto (same-renderer for goldens this machine's renderer made, else other-renderer)"
+        tolerance = ("auto (the sync against a live reference render: same-renderer; the live reference against "
+                     "the golden: same-renderer for goldens this machine's renderer made or that it equals, else other-renderer)"
                      if self.tolerance == "auto" else self.tolerance)
         return (f"goldens: {where}; image tolerance {tolerance}; results in {self.results}"
                 + ("; REGENERATING goldens" if self.regen else ""))
@@ -118,8 +121,10 @@ class Pictures:
 
         renderers = sorted({backends.renderer_label(r["details"]["renderer"])
                             for r in (record.to_json() for record in records) if "renderer" in r["details"]})
+        self.golden_summary = golden_verdicts_summary(records)
         header = [f"sync under test: {sync}", backends.describe(), f"versions: {versions}",
-                  *(f"renderer: {r}" for r in renderers), self.describe()]
+                  *(f"renderer: {r}" for r in renderers), self.describe(),
+                  *([self.golden_summary] if self.golden_summary else [])]
         self.report_path = report.write_report(records, self.results, title="FURY–pyBullet conformance: checks with pictures",
                                                header_lines=header)
         return self.report_path
@@ -131,9 +136,26 @@ class Pictures:
             terminalreporter.section("goldens regenerated")
             for line in regenerated:
                 terminalreporter.write_line(line)
+        if getattr(self, "golden_summary", ""):
+            terminalreporter.write_line(f"conformance: {self.golden_summary}")
         path = getattr(self, "report_path", None)
         if path is not None:
             terminalreporter.write_line(f"conformance: report (image checks, failing vertex checks): {path}")
+
+
+def golden_verdicts_summary(records) -> str:
+    """One line over every golden frame judged in the run: how many failed the sync verdict, how many
+    the renderer verdict, and the sets the renderer verdict used ('' when no golden was judged)."""
+    verdicts = [r.details["verdicts"] for r in records if r.kind == "golden" and isinstance(r.details.get("verdicts"), dict)]
+    if not verdicts:
+        return ""
+    failed = {name: sum(not v[name]["passed"] for v in verdicts) for name in ("sync", "renderer")}
+    sets: dict[str, int] = {}
+    for v in verdicts:
+        sets[v["renderer"]["tolerance_set"]] = sets.get(v["renderer"]["tolerance_set"], 0) + 1
+    return (f"golden pictures: {len(verdicts)} frames; sync verdict (against a live reference render) "
+            f"{failed['sync']} failed; renderer verdict (live reference against the golden) {failed['renderer']} "
+            f"failed, judged with " + ", ".join(f"{name} {n}" for name, n in sorted(sets.items())))
 
 
 def from_config(config) -> Pictures:

@@ -366,6 +366,7 @@ def kit(request: pytest.FixtureRequest, sync_implementation):
 def pytest_runtest_makereport(item: pytest.Item, call):
     report = yield
     from conformance import survey
+    from conformance.rendering.records import GOLDEN_VERDICTS
 
     _only_the_paragraph(call, report)
     survey.settle(item, report)  # survey mode: a check that noted failures fails now, naming every kind
@@ -393,6 +394,8 @@ def pytest_runtest_makereport(item: pytest.Item, call):
             "worst": item.stash.get(survey.WORST, None),
             "kinds": survey.kinds_of(item, report, message),
             "message": message.strip().splitlines()[0][:4000] if message.strip() else "",
+            # test_golden_render: each golden frame's sync and renderer verdicts (conformance.rendering.reftest).
+            "golden_verdicts": [v for k, v in item.user_properties if k == GOLDEN_VERDICTS],
             "diagnosis": next((line[len("diagnosis: "):] for line in message.splitlines() if line.startswith("diagnosis: ")), ""),
         }))
     return report

@@ -300,7 +300,7 @@ def _image_figures(item, report) -> dict[str, dict[str, Any]]:
             if not keys:
                 continue
             key = max(keys, key=lambda k: _ratio(record.metrics[k], record.limits[k], False))
-            unit = "FLIP mean" if key == "flip_mean" else "of the picture"
+            unit = "FLIP mean" if key.endswith("flip_mean") else "of the picture"  # "sync: flip_mean" …
             new = figure(value=record.metrics[key], limit=record.limits[key], unit=unit, frame=record.frame,
                          message=record.message)
             kind = "golden render"

@@ -4,14 +4,17 @@ Every reference scene has goldens at its first frame, one in the middle of the a
 (``golden/<scene>/frame-NNNN.png``, made by ``python -m conformance regen``), each with a manifest
 holding the physics state of that frame. Each golden gets two verdicts, reported separately:
 
-* ``test_golden_render``: restore the stored physics state, let the sync under test draw it, render,
-  compare with the golden within the image tolerance set in force (:mod:`conformance.rendering.compare`).
-  It judges the sync and the renderer, independent of any drift in physics. The frames are restored
-  in order in one run, so data changed without telling the renderer, a frame drawn late, recoloured bodies or
-  a moved camera all show.
+* ``test_golden_render``: restore the stored physics state, let the sync under test draw it, render;
+  then judge that picture against a live reference (the ``reference`` sync drawing the same state on
+  this renderer) with the same-renderer set, the *sync* verdict, and the live reference against the
+  golden, the *renderer* verdict (:mod:`conformance.rendering.reftest`). Both are reported apart; the
+  check fails if either does. Independent of any drift in physics. The frames are restored in order in
+  one run, so data changed without telling the renderer, a frame drawn late, recoloured bodies or a
+  moved camera all show.
   A scene's golden variants (``SceneSpec.golden_variants``: the same bodies grouped into shared
-  actors, e.g. ``test_golden_render[mixed_shapes-by_kind]``) are judged against the same goldens:
-  grouping changes how a sync must write and announce, never what the picture shows.
+  actors, e.g. ``test_golden_render[mixed_shapes-by_kind]``) are judged against the same goldens, the
+  live reference drawn through the variant's actors too: grouping changes how a sync must write and
+  announce, never what the picture shows.
 * ``test_golden_physics``: the live run's state at each golden frame against the stored one: a
   failure here is pyBullet or the platform, not rendering. Past a scene's chaotic step (the wrecking
   ball's whip) a difference is reported as a warning, not hidden and not failed.
@@ -54,27 +57,36 @@ def _goldens(pictures, scene, params=None):
 
 @each_golden_variant()
 def test_golden_render(scene_name, variant, kit, pictures, request):
-    """Each golden frame, restored and drawn by the sync under test, renders as the golden within
-    tolerance; in a golden variant, drawn through the variant's shared actors."""
-    from conformance.rendering import snapshots
+    """Each golden frame, restored and drawn by the sync under test, renders as the ``reference`` sync
+    draws the same state on this renderer (the sync verdict, same-renderer set), and that live
+    reference renders as the golden (the renderer verdict): :mod:`conformance.rendering.reftest`. In a
+    golden variant both draw through the variant's shared actors."""
+    from conformance.rendering import reftest, snapshots
 
     if pictures.regen and not variant:  # a variant has no goldens of its own to make
         pictures.note_regenerated(request.node, snapshots.regenerate(scene_name, pictures.golden_dir_for(scene_name)))
-    failures = []
     with kit.run(scene_name, **variant) as run:
         goldens = _goldens(pictures, run.scene, scenes.get(scene_name).defaults)
         physics = {v.frame: v for v in snapshots.check_physics(scene_name, goldens)}
-        for frame, golden in goldens.items():
-            record, images = snapshots.check_render(run, golden, pictures.tolerance_for(golden), sync=kit.sync)
-            record.details["physics"] = physics[frame].as_dict()
-            record.reproduce = _reproduce("test_golden_render", scene_name, kit.sync, variant)
-            record.nodeid = request.node.nodeid
-            pictures.keep(record, images)
-            if not record.passed:
-                failures.append(record)
+        drawn = {frame: snapshots.draw(run, golden) for frame, golden in goldens.items()}
+    # Drawn after the sync's run is closed: one live scene at a time, as an application has.
+    references = reftest.references(scene_name, goldens, variant)
+    failures = []
+    for frame, golden in goldens.items():
+        record, images = reftest.judge(golden, drawn[frame], references[frame], here=pictures.renderer,
+                                       override=pictures.override, sync=kit.sync)
+        record.details["physics"] = physics[frame].as_dict()
+        record.reproduce = _reproduce("test_golden_render", scene_name, kit.sync, variant)
+        record.nodeid = request.node.nodeid
+        pictures.keep(record, images)
+        request.node.user_properties.append((reftest.GOLDEN_VERDICTS, {"frame": frame, **record.details["verdicts"]}))
+        if not record.passed:
+            failures.append(record)
     if failures:
         where = f"{scene_name}({', '.join(f'{k}={v!r}' for k, v in variant.items())})" if variant else scene_name
-        lines = [f"{r.message} [{where}, frame {r.frame}, sync {kit.sync!r}]" for r in failures]
+        # Each frame's two verdicts, the failed one first: what the sync did apart from what the renderer did.
+        lines = [f"{line} [{where}, frame {r.frame}, sync {kit.sync!r}]" for r in failures
+                 for line in sorted(r.message.splitlines(), key=lambda line: " FAIL: " not in line)]
         lines.append(f"pictures: {pictures.results} (report.html); reproduce: {failures[0].reproduce}")
         pytest.fail("\n".join(lines), pytrace=False)
 
@@ -91,11 +103,11 @@ def test_golden_physics(scene_name, pictures):
     for v in verdicts:
         if not v.difference.ok and v.chaotic:
             warnings.warn(f"{scene_name} frame {v.frame} (past its chaotic step {scenes.get(scene_name).chaotic_after}): "
-                          f"physics differs from the golden's stored state, {v.difference.describe()}; its render "
-                          "verdict restores the stored state and stays valid")
+                          f"physics differs from the golden's stored state, {v.difference.describe()}; its picture "
+                          "verdicts restore the stored state and stay valid")
     if failed:
         pytest.fail("\n".join(f"physics differs from the golden's stored state at {scene_name} frame {v.frame}: "
-                              f"{v.difference.describe()}. The render verdict is unaffected (it restores the stored "
+                              f"{v.difference.describe()}. The picture verdicts are unaffected (they restore the stored "
                               "state); this is pyBullet or the platform. If pyBullet changed on purpose: "
                               f"python -m conformance regen {scene_name}" for v in failed), pytrace=False)
 

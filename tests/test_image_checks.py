@@ -25,13 +25,20 @@ SETS = (compare.SAME_RENDERER, compare.OTHER_RENDERER)
 
 
 def golden_verdicts(spec: str, scene: str, tolerance, *, camera=None):
-    """The render verdict of every golden frame of ``scene`` with sync ``spec`` (optionally rendered
-    with another ``camera`` than the goldens were)."""
+    """The render verdicts of every golden frame of ``scene`` with sync ``spec``, both held to
+    ``tolerance`` (optionally rendered with another ``camera`` than the goldens and the live
+    reference were)."""
+    from conformance import backends
+    from conformance.rendering import reftest
+
+    with scenes.build(scene) as built:
+        goldens = {f: snapshots.load(golden.default_dir(), built, f) for f in scenes.get(scene).frames_with_goldens()}
+    references = reftest.references(scene, goldens)
     with runner.running(scene, sync.load(spec)) as run:
-        goldens = {f: snapshots.load(golden.default_dir(), run.scene, f) for f in scenes.get(scene).frames_with_goldens()}
         if camera is not None:
             run.scene.camera = camera
-        return [snapshots.check_render(run, g, tolerance, sync=spec)[0] for g in goldens.values()]
+        return [snapshots.check_render(run, g, sync=spec, here=backends.renderer_info(), override=tolerance.name,
+                                       reference=references[f])[0] for f, g in goldens.items()]
 
 
 def silhouette_verdicts(spec: str, scene: str, *, camera=None):

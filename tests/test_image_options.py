@@ -42,7 +42,9 @@ def test_ini_setting_is_read_and_shown_in_the_header(tmp_path):
 def test_header_names_the_automatic_choice_and_the_results(tmp_path):
     run = _pytest("-v", cwd=tmp_path)  # -v cancels -q: the header is printed
     assert run.returncode == 0, run.stdout[-2000:]
-    assert "image tolerance auto (same-renderer for goldens this machine's renderer made, else other-renderer)" in run.stdout
+    assert ("image tolerance auto (the sync against a live reference render: same-renderer; the live reference against "
+            "the golden: same-renderer for goldens this machine's renderer made or that it equals, else other-renderer)"
+            in run.stdout)
     assert f"results in {tmp_path / 'conformance-results'}" in run.stdout
 
 

@@ -4,8 +4,6 @@ from __future__ import annotations
 
 import os
 import re
-import subprocess
-import sys
 import textwrap
 from pathlib import Path
 
@@ -13,9 +11,9 @@ import numpy as np
 import pytest
 from PIL import Image
 
-import conformance
 from conformance import backends, cli, display, images
 from conformance.errors import DisplayUnavailable
+from children import run as _run, said as _said
 
 
 def test_identical_check_fails_on_one_changed_pixel():
@@ -145,27 +143,6 @@ BROKEN = {
               ["FURY 2 renders through wgpu, which could not start", "WGPU_BACKEND_TYPE='Metal'",
                "No suitable graphics adapter found", "unset WGPU_BACKEND_TYPE", "mesa-vulkan-drivers"]),
 }
-
-
-def _environment(**variables) -> dict[str, str]:
-    """This process's environment for a child of the kit's, with every driver variable replaced by
-    ``variables``, and this checkout's ``conformance`` first on the path (a worktree's, not an install's)."""
-    from conformance import renderer_start as rs
-
-    dropped = set(rs.GL_VARIABLES + rs.WGPU_VARIABLES) | {rs.PROBED_VARIABLE, "PYTHONFAULTHANDLER"}
-    env = {k: v for k, v in display.child_environment().items() if k not in dropped}
-    checkout = str(Path(conformance.__file__).resolve().parents[1])
-    env["PYTHONPATH"] = os.pathsep.join(filter(None, [checkout, os.environ.get("PYTHONPATH")]))
-    return {**env, **variables}
-
-
-def _run(argv, cwd, **variables) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, *argv], cwd=cwd, env=_environment(**variables), capture_output=True,
-                          text=True, timeout=300, stdin=subprocess.DEVNULL)
-
-
-def _said(done: subprocess.CompletedProcess) -> str:
-    return f"status {done.returncode}\n{done.stdout[-3000:]}\n{done.stderr[-3000:]}"
 
 
 def test_a_renderer_that_cannot_start_is_one_paragraph_on_the_command_line(tmp_path):

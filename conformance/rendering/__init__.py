@@ -9,6 +9,8 @@ backend (:mod:`conformance.backends`), never from VTK or pygfx directly.
 * ``compare``: image against image, within a tolerance set (``same-renderer``, ``other-renderer``);
 * ``golden``: golden PNGs and their manifests: reading, validating, writing;
 * ``snapshots``: making goldens, the render and physics verdicts on them, regeneration;
+* ``reftest``: a golden's two picture verdicts: the sync's render against a live reference render
+  (the sync verdict) and that reference against the golden (the renderer verdict);
 * ``projection``: the scene camera as view and projection matrices, for both FURYs and pyBullet alike;
 * ``silhouettes``: each target's FURY silhouette against pyBullet's segmentation mask;
 * ``framing``: every body of a scene inside the picture and large enough to judge;

@@ -47,7 +47,9 @@ __all__ = [
 
 #: The picture roles each kind of check may write, in the order a report shows them.
 ROLES: dict[str, tuple[str, ...]] = {
-    "golden": ("expected", "actual", "difference"),
+    # The golden, the live reference (reference sync, this renderer), the sync's render; the sync verdict's
+    # difference (render vs live reference) and the renderer verdict's (live reference vs golden).
+    "golden": ("expected", "reference", "actual", "difference", "reference_difference"),
     "silhouette": ("pybullet_mask", "fury_mask", "mask_difference"),
     "framing": ("actual",),
     "vertices": ("outlined",),

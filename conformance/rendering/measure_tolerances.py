@@ -26,11 +26,14 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["BENIGN", "ERRORS", "perturbed", "pick_target", "render_frames", "with_noise"]
+__all__ = ["BENIGN", "ERRORS", "IN_PLANE", "perturbed", "pick_target", "render_frames", "with_noise"]
 
 #: The changes that must pass the other-renderer set, and those that must fail both sets.
 BENIGN = ("rerender", "noise", "msaa_off")
 ERRORS = ("moved", "turned", "recoloured")
+#: A turn in the picture plane (boxes only): not in :data:`ERRORS`, since the other-renderer set cannot
+#: promise to catch it; the live reference's same-renderer verdict does (:mod:`.measure_reftest`).
+IN_PLANE = "turned_in_plane"
 
 MOVE_PIXELS = 2.0
 TURN_DEGREES = 3.0
@@ -104,8 +107,9 @@ def _rotation(axis, degrees: float) -> np.ndarray:
 
 
 def _world_transform(run, i: int, kind: str) -> np.ndarray:
-    """The 4x4 world transform that moves (2 px across the view) or turns (3° about the view axis,
-    through the body's centre) target ``i``."""
+    """The 4x4 world transform that moves (2 px across the view), turns (3° about the camera's right
+    axis, through the body's centre) or turns in the picture plane (``turned_in_plane``: 3° about the
+    line of sight through the body's centre) target ``i``."""
     from conformance import backends
 
     t = run.drawing.targets[i]
@@ -117,6 +121,12 @@ def _world_transform(run, i: int, kind: str) -> np.ndarray:
         depth = float((centre - position) @ forward)
         pixel = 2 * depth * math.tan(math.radians(camera.view_angle) / 2) / run.scene.image_size[1]
         transform[:3, 3] = right * MOVE_PIXELS * pixel
+    elif kind == IN_PLANE:
+        # The outline turns, no face turns towards or away from the headlight: only a tolerance that
+        # needs no anti-aliasing slack (one renderer against itself) can promise to see it.
+        rotation = _rotation(centre - position, TURN_DEGREES)
+        transform[:3, :3] = rotation
+        transform[:3, 3] = centre - rotation @ centre
     else:
         # About the camera's right axis: the body tilts towards or away from the headlight, as a
         # wrong orientation usually does. (A turn in the picture plane moves a 40-100 px outline by
@@ -146,8 +156,8 @@ def perturbed(run, i: int, kind: str):
     target = run.drawing.targets[i]
     if kind == "recoloured":
         return backends.perturbed(target, recolour=_shift_hue)
-    if kind not in ("moved", "turned"):
-        raise ValueError(f"kind={kind!r}, but should be one of {ERRORS}")
+    if kind not in ("moved", "turned", IN_PLANE):
+        raise ValueError(f"kind={kind!r}, but should be one of {(*ERRORS, IN_PLANE)}")
     return backends.perturbed(target, transform=_world_transform(run, i, kind))
 
 

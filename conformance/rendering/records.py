@@ -11,8 +11,11 @@ import dataclasses
 from dataclasses import dataclass, field
 from typing import Any
 
-__all__ = ["ImageCheck"]
+__all__ = ["GOLDEN_VERDICTS", "ImageCheck"]
 
+#: The name under which test_golden_render puts each frame's sync and renderer verdicts on its report
+#: (``user_properties``), for the plugin's JSON (:mod:`.reftest`).
+GOLDEN_VERDICTS = "conformance_golden_verdicts"
 #: The kinds of image check.
 KINDS = ("vertices", "golden", "silhouette", "framing")
 

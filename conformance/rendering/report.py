@@ -10,7 +10,8 @@ inline JavaScript; with JavaScript off they stay hidden and every check is shown
 Order: failed checks first, then passes whose physics verdict differs, then passes; within each, by
 kind, scene and frame. What a card shows, from the record: its verdict, message, metrics against
 limits (``≥`` for names in :data:`AT_LEAST_PREFIXES`, else ``≤``), pictures, params, sync,
-reproduce command, and from ``details``: ``diagnosis`` (the known mistake a failure's drawing is, in
+reproduce command, and from ``details``: ``verdicts`` (a golden's sync and renderer verdicts, a chip
+each with its tolerance set: :mod:`.reftest`), ``diagnosis`` (the known mistake a failure's drawing is, in
 its own line under the message), ``tolerance_set`` (the tolerance set in force), ``physics``
 (a golden's second verdict, on the stored physics state, shown beside the render verdict: the dict of
 ``snapshots.PhysicsVerdict.as_dict()``, or a bool, or a string such as ``"pass"``), and a "chaotic"
@@ -39,13 +40,15 @@ __all__ = ["render_report", "write_report"]
 AT_LEAST_PREFIXES = ("iou", "min_", "smallest_", "coverage")
 
 _LABELS = {"expected": "expected (golden)", "actual": "actual (render)", "difference": "difference",
+           "reference": "live reference (reference sync, this renderer)",
+           "reference_difference": "renderer verdict: live reference vs golden",
            "pybullet_mask": "pyBullet mask", "fury_mask": "FURY mask", "mask_difference": "mask difference",
            "outlined": "the sync's drawing, with the outline of where pyBullet has each failing body"}
 # The colours silhouettes.mask_images uses; shown under the picture so it can be read without the code.
 _LEGENDS = {"mask_difference": (("#fff", "both"), ("#f00", "only FURY"), ("#00f", "only pyBullet"),
                                 ("#ff0", "different targets")),
             "outlined": (("#f0f", "pyBullet's outline"),)}
-_SHOWN_DETAILS = ("tolerance_set", "physics", "chaotic", "chaotic_after", "diagnosis")
+_SHOWN_DETAILS = ("tolerance_set", "physics", "chaotic", "chaotic_after", "diagnosis", "verdicts")
 #: At most this many rows of a table in "details" (a pile has hundreds of targets).
 MAX_ROWS = 200
 
@@ -150,10 +153,21 @@ def _metrics(record: ImageCheck) -> str:
 
 def _chips(record: ImageCheck) -> str:
     chips = []
+    verdicts = record.details.get("verdicts")
+    if isinstance(verdicts, dict):
+        # A golden's picture verdicts, apart: what the sync did (against the live reference) and what
+        # the renderer did (the live reference against the golden).
+        for name, verdict in verdicts.items():
+            if isinstance(verdict, dict):
+                state = "pass" if verdict.get("passed") else "fail"
+                chips.append(f'<span class="chip {state}" title="{_e(verdict.get("message", ""))}; set '
+                             f'{_e(verdict.get("tolerance_set", ""))}: {_e(verdict.get("why", ""))}">'
+                             f'{_e(name)}: {state} ({_e(verdict.get("tolerance_set", ""))})</span>')
     if "physics" in record.details:
         # A golden has two verdicts: the picture (the record's) and the stored physics state's.
-        render = "pass" if record.passed else "fail"
-        chips.append(f'<span class="chip {render}">render: {render}</span>')
+        if not isinstance(verdicts, dict):
+            render = "pass" if record.passed else "fail"
+            chips.append(f'<span class="chip {render}">render: {render}</span>')
         state, text = _verdict(record.details["physics"])
         chips.append(f'<span class="chip {state}" title="{_e(text)}">physics: {_e(text)}</span>')
     chaotic = _chaotic(record)
@@ -161,7 +175,7 @@ def _chips(record: ImageCheck) -> str:
         after = "" if chaotic is True else f" (after step {chaotic})"
         chips.append(f'<span class="chip warn" title="small platform differences in floating point grow here; '
                      f'the stored physics state may not be reproduced on another machine">chaotic{_e(after)}</span>')
-    if record.details.get("tolerance_set"):
+    if record.details.get("tolerance_set") and not isinstance(verdicts, dict):
         chips.append(f'<span class="chip">tolerance set: {_e(record.details["tolerance_set"])}</span>')
     if record.sync:
         chips.append(f'<span class="chip">sync: {_e(record.sync)}</span>')

@@ -3,11 +3,13 @@
 * :func:`make` runs a scene with the reference sync and renders it at its golden frames
   (``SceneSpec.frames_with_goldens()``: the first, the middle of the action, the last), capturing the
   physics state of each frame for the manifest;
-* :func:`check_render` (the *render* verdict) restores a golden's stored physics state in a run of
-  the sync under test, syncs, renders and compares with the golden: it judges the sync and the
-  renderer, whatever pyBullet does on this machine. Frames are checked in order in one run, so what a
-  sync leaves behind from one frame (geometry it changed without telling VTK, a pose it draws a
-  frame late) shows in the next;
+* :func:`check_render` (the *render* verdicts) restores a golden's stored physics state in a run of
+  the sync under test, syncs and renders (:func:`draw`), then judges the picture twice
+  (:mod:`conformance.rendering.reftest`): against a live reference render of the same state (the
+  *sync* verdict) and the live reference against the golden (the *renderer* verdict), whatever
+  pyBullet does on this machine. Frames are checked in order in one run, so what a sync leaves
+  behind from one frame (geometry it changed without telling VTK, a pose it draws a frame late)
+  shows in the next;
 * :func:`check_physics` (the *physics* verdict) compares a live run's state at each golden frame
   with the stored one: a difference there is pyBullet or the platform, not rendering;
 * :func:`regenerate` writes goldens anew (atomically, unchanged bytes untouched) and says what
@@ -17,7 +19,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 import functools
 from dataclasses import dataclass
 from pathlib import Path
@@ -30,8 +31,8 @@ from conformance.errors import GoldenError
 from conformance.rendering import golden as storage
 from conformance.rendering.records import ImageCheck
 
-__all__ = ["Change", "check_physics", "check_render", "make", "only_float_noise", "regenerate", "same_renderer",
-           "tolerance_for"]
+__all__ = ["Change", "check_physics", "check_render", "draw", "make", "only_float_noise", "regenerate",
+           "same_renderer"]
 
 #: The sync whose drawing the goldens show.
 GOLDEN_SYNC = "reference"
@@ -39,16 +40,6 @@ def same_renderer(made_by: dict[str, str], here: dict[str, str]) -> bool:
     """Whether a golden was made by the renderer this machine has: the same backend, library versions
     and GPU (OpenGL strings for VTK, the wgpu adapter for pygfx), every key either side names."""
     return all(made_by.get(k) == here.get(k) for k in set(made_by) | set(here))
-
-
-def tolerance_for(golden: storage.Golden, here: dict[str, str], override: str | None = None):
-    """The image tolerance set in force for ``golden``: the one named by ``override``, else
-    ``same-renderer`` when the golden's manifest names this machine's renderer, else ``other-renderer``."""
-    from conformance.rendering import compare
-
-    if override:
-        return compare.tolerance(override)
-    return compare.SAME_RENDERER if same_renderer(golden.renderer, here) else compare.OTHER_RENDERER
 
 
 def manifest(run, frame: int, captured: dict[str, Any], renderer: dict[str, str]) -> dict[str, Any]:
@@ -93,25 +84,29 @@ def load(directory: Path | str, scene, frame: int, params=None) -> storage.Golde
                         camera=scene.camera.as_dict(), size=tuple(scene.image_size))
 
 
-def check_render(run, golden: storage.Golden, tolerance, *, sync: str) -> tuple[ImageCheck, dict[str, np.ndarray]]:
-    """The render verdict on one golden frame, and the pictures for a failure report."""
-    from conformance.rendering import compare
-
+def draw(run, golden: storage.Golden) -> np.ndarray:
+    """The sync under test's render of a golden frame: the golden's stored physics state restored in
+    ``run``, the sync called once, the picture taken. Call it frame after frame in one run, so that
+    what a sync leaves behind from one frame shows in the next."""
     frame = golden.manifest["frame"]
     state.restore(run.scene, golden.state)
     run.frame = frame
     run.sync()
-    actual = backends.render(run.drawing, run.scene.camera, run.scene.image_size)
-    record = compare.compare_images(golden.image, actual, tolerance)
-    record = dataclasses.replace(record, kind="golden", scene=run.scene.name, frame=frame, sync=sync,
-                                 params=storage.jsonable(dict(run.scene.params)))
-    record.details.setdefault("tolerance_set", tolerance.name)
-    record.details["golden"] = str(golden.png)
-    record.details["golden_renderer"] = golden.renderer
-    pictures = {"expected": golden.image, "actual": actual}
-    if not record.passed:
-        pictures["difference"] = compare.difference_image(golden.image, actual)
-    return record, pictures
+    return backends.render(run.drawing, run.scene.camera, run.scene.image_size)
+
+
+def check_render(run, golden: storage.Golden, *, sync: str, here: dict[str, str], override: str | None = None,
+                 reference: np.ndarray | None = None) -> tuple[ImageCheck, dict[str, np.ndarray]]:
+    """Both picture verdicts on one golden frame (:func:`conformance.rendering.reftest.judge`): the sync's
+    render against the live reference, and the live reference against the golden; and the pictures for
+    the report. ``reference``: the live reference if already drawn (else drawn now, in a second scene)."""
+    from conformance.rendering import reftest
+
+    actual = draw(run, golden)
+    if reference is None:
+        reference = reftest.references(run.scene.name, {golden.manifest["frame"]: golden},
+                                       run.scene.params)[golden.manifest["frame"]]
+    return reftest.judge(golden, actual, reference, here=here, override=override, sync=sync)
 
 
 @dataclass(frozen=True)
@@ -216,9 +211,10 @@ def regenerate(scene_name: str, directory: Path | str, *, mode: str = "all", tol
         if old is not None and mode == "missing":
             continue
         if old is not None and mode == "failing":
-            from conformance.rendering import compare
+            from conformance.rendering import compare, reftest
 
-            if compare.compare_images(old.image, image, tolerance_for(old, here, tolerance_override)).passed:
+            # The fresh picture is a live reference: failing is the renderer verdict failing.
+            if compare.compare_images(old.image, image, reftest.renderer_tolerance(old, image, here, tolerance_override)[0]).passed:
                 continue
         noise = only_float_noise(old, image, made) if old is not None else None
         if noise is not None:  # writing it would commit another CPU's last bits, and nothing else
