@@ -159,7 +159,7 @@ def test_a_run_reports_both_verdicts_apart_in_the_terminal_the_json_and_the_page
     assert sorted(by_frame) == list(FRAMES)
     assert by_frame[FRAMES[1]]["sync"]["passed"] and not by_frame[FRAMES[1]]["renderer"]["passed"]
     page = (results / "report.html").read_text(encoding="utf-8")
-    assert "renderer: fail (other-renderer)" in page and "sync: pass (same-renderer)" in page
+    assert "renderer verdict: fail (other-renderer)" in page and "sync verdict: pass (same-renderer)" in page
     assert "live reference (reference sync, this renderer)" in page and "renderer verdict: live reference vs golden" in page
 
 

@@ -13,7 +13,7 @@ limits (``≥`` for names in :data:`AT_LEAST_PREFIXES`, else ``≤``), pictures,
 reproduce command, and from ``details``: ``verdicts`` (a golden's sync and renderer verdicts, a chip
 each with its tolerance set: :mod:`.reftest`), ``diagnosis`` (the known mistake a failure's drawing is, in
 its own line under the message), ``tolerance_set`` (the tolerance set in force), ``physics``
-(a golden's second verdict, on the stored physics state, shown beside the render verdict: the dict of
+(a golden's second verdict, on the stored physics state, shown beside the picture verdicts: the dict of
 ``snapshots.PhysicsVerdict.as_dict()``, or a bool, or a string such as ``"pass"``), and a "chaotic"
 note when ``details["physics"]["chaotic"]`` or ``details["chaotic"]`` is true or the frame is past
 ``details["chaotic_after"]``. Other details are listed under "details": lists of rows (per-target
@@ -39,7 +39,8 @@ __all__ = ["render_report", "write_report"]
 #: Metric names held to a lower bound (``iou`` ≥ limit); every other limit is an upper bound.
 AT_LEAST_PREFIXES = ("iou", "min_", "smallest_", "coverage")
 
-_LABELS = {"expected": "expected (golden)", "actual": "actual (render)", "difference": "difference",
+_LABELS = {"expected": "expected (golden)", "actual": "actual (the sync's render)",
+           "difference": "sync verdict: render vs live reference",
            "reference": "live reference (reference sync, this renderer)",
            "reference_difference": "renderer verdict: live reference vs golden",
            "pybullet_mask": "pyBullet mask", "fury_mask": "FURY mask", "mask_difference": "mask difference",
@@ -162,7 +163,7 @@ def _chips(record: ImageCheck) -> str:
                 state = "pass" if verdict.get("passed") else "fail"
                 chips.append(f'<span class="chip {state}" title="{_e(verdict.get("message", ""))}; set '
                              f'{_e(verdict.get("tolerance_set", ""))}: {_e(verdict.get("why", ""))}">'
-                             f'{_e(name)}: {state} ({_e(verdict.get("tolerance_set", ""))})</span>')
+                             f'{_e(name)} verdict: {state} ({_e(verdict.get("tolerance_set", ""))})</span>')
     if "physics" in record.details:
         # A golden has two verdicts: the picture (the record's) and the stored physics state's.
         if not isinstance(verdicts, dict):

@@ -192,7 +192,7 @@ def only_float_noise(old: storage.Golden, image: np.ndarray, made: dict[str, Any
 
 def regenerate(scene_name: str, directory: Path | str, *, mode: str = "all", tolerance_override: str | None = None) -> list[Change]:
     """Make a scene's goldens anew and write those that ``mode`` selects: ``all``, ``missing``
-    (missing or unreadable), or ``failing`` (missing, unreadable, or failing the render verdict
+    (missing or unreadable), or ``failing`` (missing, unreadable, or failing the renderer verdict
     with the reference sync). A selected golden that differs only by float noise
     (:func:`only_float_noise`) is kept: neither file is touched."""
     from conformance import images, scenes
