@@ -106,10 +106,11 @@ def _suite_table(results: Results) -> list[str]:
 
 
 def _apps_table(results: Results) -> list[str]:
-    lines = ["| app | ticks | the app's own tick | recording | judging | kit ÷ app |", "|---|---|---|---|---|---|"]
+    lines = ["| app | ticks | the app's own tick | recording | judging | kit ÷ app | pictures, once a run |",
+             "|---|---|---|---|---|---|---|"]
     for f in results.apps:
         lines.append(f"| {f.name} | {f.ticks} | {f.baseline * 1e3:.1f} ms | {f.record * 1e3:.1f} ms | "
-                     f"{f.judge * 1e3:.1f} ms | {_ratio(f.ratio)} |")
+                     f"{f.judge * 1e3:.1f} ms | {_ratio(f.ratio)} | {getattr(f, 'picture', 0.0) * 1e3:.0f} ms |")
     return lines
 
 

@@ -5,7 +5,8 @@ standing for ``vtk`` or ``pygfx``) or on the command line (``--conformance-app P
 app gets one check per verdict of :mod:`conformance.apps.judge` (``test_app[APP-attached]`` …), judged on
 one run of the app (:func:`conformance.apps.check_app`, shared by its checks), and
 ``test_app_perturbed[APP]``: runs with the kit's teleports, kicks and joint resets between ticks, drawn
-by Hypothesis (:mod:`conformance.apps.perturbed`). Each failure ends with the command that replays it.
+by Hypothesis (:mod:`conformance.apps.perturbed`). Each failure ends with the command that replays it; a
+failing ``pictured`` check also names its pictures, written where the scene checks' silhouettes go.
 """
 
 from __future__ import annotations
@@ -40,19 +41,28 @@ def _own_run(config, app):
     return _RUNS[key]
 
 
+def _kept(verdict, result, pictures, request) -> str:
+    """The ``pictured`` check's pictures, written where the scene checks' go; a line naming them."""
+    from conformance.apps import pictured
+
+    paths = pictured.keep(verdict, pictures.results, result.reproduce(), request.node.nodeid, pictures.keep_passing)
+    return f"\npictures (under {pictures.results}): {', '.join(paths)}" if paths and not verdict.passed else ""
+
+
 @pytest.mark.parametrize("check", app_mode.CHECKS)
-def test_app(app, check, request):
+def test_app(app, check, request, pictures):
     """The app's own run passes ``check`` (:mod:`conformance.apps.judge` says what each guarantees)."""
     result = _own_run(request.config, app)
     if isinstance(result, app_mode.AppFailed):
         pytest.fail(f"{app}: {result}", pytrace=False)
     verdict = result.verdicts[check]
+    kept = _kept(verdict, result, pictures, request) if check == "pictured" else ""
     if not verdict.passed:
-        pytest.fail(f"{check} [app {app}, {result.recording.ticks} ticks]\n{verdict.message()}\n"
+        pytest.fail(f"{check} [app {app}, {result.recording.ticks} ticks]\n{verdict.message()}{kept}\n"
                     f"reproduce: {result.reproduce()}", pytrace=False)
 
 
-def test_app_perturbed(app, request):
+def test_app_perturbed(app, request, pictures):
     """The app passes every check when the kit turns, kicks and resets its bodies between ticks: a sync
     right only for the motions the app happens to produce fails here."""
     from conformance import profiles
@@ -65,5 +75,6 @@ def test_app_perturbed(app, request):
     if found is not None:
         failing = {k: v for k, v in found.verdicts.items() if not v.passed}
         lines = "\n".join(f"{k}: {v.message()}" for k, v in failing.items())
-        pytest.fail(f"perturbed run of {app} (events as drawn, not shrunk)\n{lines}\nreproduce: {found.reproduce()}",
+        kept = _kept(found.verdicts["pictured"], found, pictures, request) if "pictured" in failing else ""
+        pytest.fail(f"perturbed run of {app} (events as drawn, not shrunk)\n{lines}{kept}\nreproduce: {found.reproduce()}",
                     pytrace=False)

@@ -124,6 +124,7 @@ class Driver:
         self._steps = 0
         self._tick = 0
         self._reading = 0.0  # seconds of the kit's reads inside the app's ticks (before each step)
+        self._picturing = 0.0  # seconds of the pictures at the end of the run
         self._stepped = False  # this tick has called stepSimulation
         self._written = None   # (positions, orientations, velocities) just before the first write since the last step
         self._writers: set[str] = set()
@@ -248,6 +249,7 @@ class Driver:
         except Exception as exc:  # the app's own code raised inside its callback: that is a verdict
             self.raised(exc)
             ended = f"the app raised at tick {len(steps)}"
+        pictures = [self._picture(source, tracks, clients, len(steps) - 1)]
         notes = []
         if source.actors() and len(source.actors()) != len(actors):
             notes.append(f"the scene had {len(actors)} actors when the loop started and {len(source.actors())} at its end; "
@@ -258,8 +260,22 @@ class Driver:
             before_positions=np.array(before_pos), before_orientations=np.array(before_orn),
             steps=np.array(steps, dtype=np.int64), loop=f"{source.describe()} (handed over at {self.entry or 'the end of the script'})",
             ended=ended, events=[perturb.as_dict(e) for e in self.events], notes=notes,
-            writes=np.array(writes), writers=writers, mapping=mapped,
-            seconds={"app": in_ticks - self._reading, "record": in_snapshots + self._reading})
+            writes=np.array(writes), writers=writers, mapping=mapped, pictures=pictures,
+            seconds={"app": in_ticks - self._reading, "record": in_snapshots + self._reading,
+                     "picture": self._picturing})
+
+    def _picture(self, source, tracks, clients, tick: int) -> dict:
+        """The pictures of the last tick (:mod:`conformance.apps.picture`); a picture that cannot be taken
+        leaves the other checks' recording whole and says why."""
+        from conformance.apps import picture
+
+        start = time.perf_counter()
+        try:
+            return picture.take(source, tracks, self._frames, clients, tick)
+        except Exception as exc:  # a renderer that cannot draw here must not cost the vertex checks
+            return {"tick": tick, "skipped": f"the picture could not be drawn: {type(exc).__name__}: {exc}"}
+        finally:
+            self._picturing = time.perf_counter() - start
 
 
 class _Track:
@@ -273,6 +289,7 @@ class _Track:
         self.announced: list[bool] = []
         self.missed: list[tuple[int, str]] = []
         self._state = None
+        self.gpu: np.ndarray | None = None  # FURY 2: the positions as the GPU holds them (None on VTK)
 
     def snapshot(self) -> None:
         self.vertices.append(np.array(self.backend.world_vertices(self.actor), dtype=np.float64))
@@ -292,7 +309,19 @@ class _Track:
             if missed:
                 self.missed.append((len(self.changed) - 1, missed))
         self._state = state
-        self.backend.hand_over(self.actor)  # as the window's next frame would, so the next tick starts clean
+        taken = self.backend.hand_over(self.actor)  # as the window's next frame would, so the next tick starts clean
+        if taken is not None:
+            self._keep_gpu(taken.get("positions", []))
+
+    def _keep_gpu(self, chunks) -> None:
+        """Copy what the renderer would upload of the positions now (whole chunks, as announced): the
+        GPU's vertices, which the picture check draws (:mod:`conformance.apps.picture`)."""
+        data = np.asarray(self.actor.geometry.positions.data)
+        if self.gpu is None or self.gpu.shape != data.shape:
+            self.gpu = np.array(data, copy=True)  # a new buffer is uploaded whole
+            return
+        for offset, size in chunks:
+            self.gpu[offset:offset + size] = data[offset:offset + size]
 
     def result(self, ticks: int) -> ActorTrack:
         kind = type(self.actor).__name__

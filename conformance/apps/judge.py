@@ -10,7 +10,9 @@ Checks (the names are the pytest ids and the ``app`` command's lines):
 * ``normals``: stored vertex normals turn with the frame that holds their vertices;
 * ``announced``: every change of an actor's vertex data was announced to the renderer at the tick it was made;
 * ``untouched``: after a tick's last ``stepSimulation`` — where the sync runs — the app leaves every body's pose
-  and velocity as pyBullet computed them (a sync only reads the simulation; the guide's recipes only read).
+  and velocity as pyBullet computed them (a sync only reads the simulation; the guide's recipes only read);
+* ``pictured``: the app's picture at the end of the run, from its own camera, shows each body where pyBullet's
+  own renderer shows it (:mod:`conformance.apps.pictured`).
 
 Everything is computed from the :class:`~conformance.apps.recording.Recording` alone.
 """
@@ -29,7 +31,7 @@ from conformance.tolerances import DEFAULT, Tolerance
 
 __all__ = ["CHECKS", "DIAGNOSES", "Verdict", "judge"]
 
-CHECKS = ("runs", "attached", "drawn", "placed", "normals", "announced", "untouched")
+CHECKS = ("runs", "attached", "drawn", "placed", "normals", "announced", "untouched", "pictured")
 
 #: A write that changes a pose or velocity by no more than this is no change (resetting a body to the
 #: pose just read may round its last bit).
@@ -49,6 +51,11 @@ DIAGNOSES = {name: text for name, (text, _) in attach_mod.VARIANTS.items()} | {
     "written-back": "the pose that was drawn (as read, or rounded to float32) is written back into pyBullet "
                     "(\"so physics and graphics agree\"): resetBasePositionAndOrientation also sets the body's "
                     "velocity to zero (pybullet 3.2.7), so the simulation is changed; a sync only reads",
+    "hidden": "its actor is hidden (SetVisibility(0) on FURY 0.12, visible = False on FURY 2) or drawn fainter than "
+              "opacity 32/255, so the picture does not show a body pyBullet has there: keep each body's actor shown",
+    "stale-gpu": "the GPU still holds older vertices of this body: the vertices were written but the range announced "
+                 "with positions.update_range(offset, count) does not cover them (offset and count are in vertices); "
+                 "announce every range written, or update_full()",
 }
 
 
@@ -60,6 +67,8 @@ class Verdict:
     diagnoses: list = field(default_factory=list)
     worst: float | None = None      # worst error / allowance, where the check measures one
     notes: list = field(default_factory=list)
+    #: (ImageCheck, pictures by role) of each picture compared (``pictured``): the artefacts to keep
+    pictures: list = field(default_factory=list)
 
     def message(self) -> str:
         return "\n".join(self.lines)
@@ -88,6 +97,7 @@ class _Judgement:
             self._apply_mapping(entry)
         self.followed_badly: set[int] = set()
         self._attached_done = False
+        self._placements = None
 
     def _apply_mapping(self, entry: dict) -> None:
         """Judge the mapped vertices in the frame the mapping names, not the one that holds them best:
@@ -318,28 +328,43 @@ class _Judgement:
                     return f"{track.label} vertices {start}:{stop}"
         return ""
 
+    def placements(self) -> list:
+        """``(track, attachment, frame, rows, Placement)`` of every actor's held vertices of every frame,
+        computed once: ``placed`` judges them, and ``pictured`` judges the frames they decide are drawn as
+        their collision shape."""
+        if self._placements is None:
+            self._placements = []
+            for track, a in zip(self.r.actors, self.attachments):
+                for frame in np.unique(a.frame):
+                    if frame < 0:
+                        continue
+                    rows = np.flatnonzero((a.frame == frame) & a.held)
+                    if not len(rows):
+                        continue
+                    result = place(a.reference[rows], self.r.frames[frame].shapes, self._inertial(frame),
+                                   tolerance=self.tolerance)
+                    self._placements.append((track, a, int(frame), rows, result))
+        return self._placements
+
+    def pictured(self) -> Verdict:
+        from conformance.apps import pictured
+
+        return pictured.check(self)
+
     def placed(self) -> Verdict:
         verdict = Verdict("placed", True)
-        for track, a in zip(self.r.actors, self.attachments):
-            for frame in np.unique(a.frame):
-                if frame < 0:
-                    continue
-                rows = np.flatnonzero((a.frame == frame) & a.held)
-                if not len(rows):
-                    continue
-                info = self.r.frames[frame]
-                inertial = self._inertial(frame)
-                result = place(a.reference[rows], info.shapes, inertial, tolerance=self.tolerance)
-                where = f"{track.label} vertices {rows[0]}:{rows[-1] + 1} held by {info.label}"
-                if not result.judged:
-                    verdict.notes.append(f"{where}: {result.why}")
-                elif not result.ok:
-                    verdict.passed = False
-                    diagnosis = result.diagnosis or self._other_body(result.offset, frame)
-                    verdict.lines.append(f"{where}: {result.why}")
-                    if diagnosis:
-                        verdict.lines.append(f"    diagnosis: {DIAGNOSES[diagnosis]}")
-                        verdict.diagnoses.append(diagnosis)
+        for track, a, frame, rows, result in self.placements():
+            info = self.r.frames[frame]
+            where = f"{track.label} vertices {rows[0]}:{rows[-1] + 1} held by {info.label}"
+            if not result.judged:
+                verdict.notes.append(f"{where}: {result.why}")
+            elif not result.ok:
+                verdict.passed = False
+                diagnosis = result.diagnosis or self._other_body(result.offset, frame)
+                verdict.lines.append(f"{where}: {result.why}")
+                if diagnosis:
+                    verdict.lines.append(f"    diagnosis: {DIAGNOSES[diagnosis]}")
+                    verdict.diagnoses.append(diagnosis)
         return verdict
 
     def _inertial(self, frame: int) -> np.ndarray:

@@ -69,6 +69,9 @@ class Recording:
     writers: list = field(default_factory=list)  # per tick, the names of the writing calls
     #: the app's mapping (:mod:`conformance.apps.mapping`): {"actor", "start", "stop", "frame"} entries
     mapping: list = field(default_factory=list)
+    #: the pictures taken at the end of the run (:func:`conformance.apps.picture.take`): dicts whose
+    #: array values are numpy arrays
+    pictures: list = field(default_factory=list)
 
     @property
     def ticks(self) -> int:
@@ -96,6 +99,17 @@ def save(recording: Recording, path) -> None:
             "events": recording.events, "notes": recording.notes,
             "error": recording.error, "seconds": recording.seconds, "writers": recording.writers,
             "mapping": recording.mapping}
+    pictures = []
+    for i, shot in enumerate(recording.pictures):
+        plain = {}
+        for key, value in shot.items():
+            if isinstance(value, np.ndarray):
+                arrays[f"p{i}_{key}"] = value
+                plain.setdefault("arrays", []).append(key)
+            else:
+                plain[key] = value
+        pictures.append(plain)
+    meta["pictures"] = pictures
     arrays["meta"] = np.frombuffer(json.dumps(meta).encode("utf-8"), dtype=np.uint8)
     buffer = io.BytesIO()
     np.savez(buffer, **arrays)
@@ -110,6 +124,11 @@ def _frame(d: dict) -> Frame:
 def load(path) -> Recording:
     with np.load(path) as data:
         meta = json.loads(bytes(data["meta"]).decode("utf-8"))
+        pictures = []
+        for i, plain in enumerate(meta.get("pictures", [])):
+            shot = {k: v for k, v in plain.items() if k != "arrays"}
+            shot.update({key: data[f"p{i}_{key}"] for key in plain.get("arrays", [])})
+            pictures.append(shot)
         actors = []
         for i, a in enumerate(meta["actors"]):
             actors.append(ActorTrack(a["label"], a["kind"], data[f"a{i}_vertices"],
@@ -121,4 +140,4 @@ def load(path) -> Recording:
                          data["before_orientations"], data["steps"], meta["loop"], meta["ended"],
                          meta["events"], meta["notes"], meta.get("error", ""),
                          meta.get("seconds", {}), data["writes"] if "writes" in data else None,
-                         meta.get("writers", []), meta.get("mapping", []))
+                         meta.get("writers", []), mapping=meta.get("mapping", []), pictures=pictures)

@@ -16,6 +16,8 @@ callback, or when it calls ``showm.close()``.
 
 from __future__ import annotations
 
+import inspect
+
 __all__ = ["install", "scene_actors"]
 
 
@@ -47,6 +49,16 @@ class _Source:
     def ended(self) -> str:
         return "the app called showm.close()" if self.closed else "the app cancelled its callbacks"
 
+    def camera(self):
+        from conformance.apps import picture_pygfx
+
+        return picture_pygfx.camera(self.showm)
+
+    def faces(self, actors, camera, size, gpu):
+        from conformance.apps import picture_pygfx
+
+        return picture_pygfx.faces(self.showm, actors, camera, size, gpu)
+
 
 def scene_actors(scene) -> list:
     """Every mesh under the scene (its main scene for a FURY 2 ``Scene``), in scene-graph order."""
@@ -65,10 +77,16 @@ def install(driver) -> None:
 
     original_init = window.ShowManager.__init__
     original_close = window.ShowManager.close
+    signature = inspect.signature(original_init)
+    default_size = tuple(signature.parameters["size"].default) if "size" in signature.parameters else (800, 800)
 
     def __init__(self, *args, **kwargs):
         kwargs["window_type"] = "offscreen"
         original_init(self, *args, **kwargs)
+        try:  # the picture check draws at the app's aspect
+            self._kit_app_size = tuple(signature.bind(self, *args, **kwargs).arguments.get("size", default_size))
+        except TypeError:
+            self._kit_app_size = default_size
         self._kit_source = _Source(self)
         driver.offer(self._kit_source)
 

@@ -44,6 +44,16 @@ class _Source:
     def ended(self) -> str:
         return "the app called showm.exit()"
 
+    def camera(self):
+        from conformance.apps import picture_vtk
+
+        return picture_vtk.camera(self.showm)
+
+    def faces(self, actors, camera, size, gpu):
+        from conformance.apps import picture_vtk
+
+        return picture_vtk.faces(self.showm, actors, camera, size, gpu)
+
 
 def scene_actors(scene) -> list:
     """The scene's 3D actors that draw polygon data (2D text and UI actors are not bodies)."""
@@ -68,8 +78,12 @@ def install(driver) -> None:
 
     def __init__(self, *args, **kwargs):
         original_init(self, *args, **kwargs)
+        self._kit_app_size = tuple(self.size)  # the picture check draws at the app's aspect
         self.window.SetOffScreenRendering(1)  # drawn on the kit's display, never mapped
         self.window.SetSize(*SIZE)
+        # No multisampling: the picture check draws faces in code colours in this window, which blending
+        # would spoil; the recorded vertices do not depend on it.
+        self.window.SetMultiSamples(0)
         self._kit_source = _Source(self)
         driver.offer(self._kit_source)
 

@@ -154,18 +154,20 @@ def id_colors(count: int) -> np.ndarray:
     return np.stack([(values >> 16) & 255, (values >> 8) & 255, values & 255], axis=1).astype(np.uint8)
 
 
-def decode_ids(picture: np.ndarray, count: int) -> np.ndarray:
+def decode_ids(picture: np.ndarray, count: int, *, strict: bool = True) -> np.ndarray:
     """``(h, w)`` int32 target index of each pixel of an ID ``picture`` (-1 for the background).
 
     Raises ``RuntimeError`` if any pixel is neither the background nor exactly a target's colour:
-    the renderer blended (anti-aliasing, lighting, translucency), and the picture cannot be trusted."""
+    the renderer blended (anti-aliasing, lighting, translucency), and the picture cannot be trusted.
+    With ``strict=False`` such pixels are -2 instead (an app's own actors may carry a shader or texture
+    the kit cannot switch off: its pixels are then unknown, not the whole picture)."""
     stride = max(1, (2**24 - 1) // (count + 1))
     values = (picture[..., 0].astype(np.int64) << 16) | (picture[..., 1].astype(np.int64) << 8) | picture[..., 2]
     index, remainder = np.divmod(values, stride)
     bad = (remainder != 0) | (index > count)
-    if bad.any():
+    if bad.any() and strict:
         raise RuntimeError(f"ID render: {int(bad.sum())} pixels are not exactly a target's colour (blended?)")
-    return (index - 1).astype(np.int32)
+    return np.where(bad, -2, index - 1).astype(np.int32)
 
 
 def id_codes(drawing: Drawing, vertex_count: Callable[[Any], int]) -> list[tuple[Any, np.ndarray]]:

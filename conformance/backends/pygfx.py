@@ -179,9 +179,11 @@ def hand_over(actor) -> None:
     renderer asks each buffer for its pending ranges (``_gfx_get_chunk_descriptions``, which clears them)
     and uploads them. Until that happens a buffer stays "wholly pending" and further ``update_range``
     calls do not move its revision, so a change announced every frame would look unannounced. App mode
-    calls this after every tick, where the app's own window does not draw."""
-    for _, buffer in _buffers(actor):
-        buffer._gfx_get_chunk_descriptions()
+    calls this after every tick, where the app's own window does not draw.
+
+    Returns, per buffer name, the ``(offset, size)`` item ranges taken: what the renderer would upload,
+    whole chunks of them, so app mode keeps a copy of what the GPU holds (:mod:`conformance.apps.picture`)."""
+    return {name: [tuple(d[:2]) for d in buffer._gfx_get_chunk_descriptions()] for name, buffer in _buffers(actor)}
 
 
 def content_time(actor) -> int:

@@ -141,7 +141,9 @@ def content_time(actor) -> int:
 
 
 def hand_over(actor) -> None:
-    """Nothing to take: VTK's modification times only grow, so every announcement shows (see pygfx's)."""
+    """Nothing to take: VTK's modification times only grow, so every announcement shows (see pygfx's);
+    and VTK uploads the whole geometry whenever its time moved, so there is no GPU copy to keep (None)."""
+    return None
 
 
 def content_state(actor) -> tuple[int, bytes]:

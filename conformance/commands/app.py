@@ -22,9 +22,11 @@ def add_arguments(parser) -> None:
     parser.add_argument("--tick", default=None, metavar="NAME", help="a module-level function of the app to call once "
                         "a tick, for an app whose loop is its own")
     parser.add_argument("--timeout", default="300", metavar="S", help="seconds one run of the app may take (default 300)")
+    parser.add_argument("--results", default=None, metavar="DIR", help="where a failing picture check writes its "
+                        "pictures and every picture's record (default: the scene checks' results directory)")
 
 
-def _print_result(result, label: str) -> None:
+def _print_result(result, label: str, results=None) -> None:
     r = result.recording
     steps = sorted(set(int(s) for s in r.steps[1:])) or [0]
     print(f"{label}: {r.ticks} ticks ({'/'.join(map(str, steps))} step(s) per tick); {r.ended}")
@@ -35,6 +37,13 @@ def _print_result(result, label: str) -> None:
             print(f"      {line}")
         if len(verdict.lines) > 12:
             print(f"      … {len(verdict.lines) - 12} more lines")
+        if check == "pictured" and results is not None:
+            from conformance.apps import pictured
+
+            written = pictured.keep(verdict, results, result.reproduce())
+            if written and not verdict.passed:
+                print(f"      pictures (under {results}): {', '.join(written[:3])}"
+                      + (f" and {len(written) - 3} more" if len(written) > 3 else ""))
     if not result.passed:
         print(f"  reproduce: {result.reproduce()}")
 
@@ -52,6 +61,9 @@ def run(args, extra) -> int:
         from conformance.apps import perturb
 
         events = [perturb.as_dict(e) for e in perturb.from_dicts(json.loads(args.events) if args.events.strip() else [])]
+    from pathlib import Path
+
+    results = Path(args.results or validation.DEFAULT_RESULTS)
     failed = 0
     for path in args.paths:
         print(f"app {path} ({backends.describe()})")
@@ -62,7 +74,7 @@ def run(args, extra) -> int:
             failed += 1
             continue
         print(f"  loop: {result.recording.loop}")
-        _print_result(result, "own run" if not events else "run with the given events")
+        _print_result(result, "own run" if not events else "run with the given events", results)
         ok = result.passed
         if ok and events is None and runs:
             found = perturbed.search(path, examples=runs, tick_function=args.tick, timeout=timeout)
@@ -70,7 +82,7 @@ def run(args, extra) -> int:
                 print(f"  PASS perturbed: {runs} runs of {apps.PERTURBED_TICKS} ticks with the kit's teleports, kicks and joint resets")
             else:
                 ok = False
-                _print_result(found, f"perturbed run (events {json.dumps(found.events)}; not shrunk)")
+                _print_result(found, f"perturbed run (events {json.dumps(found.events)}; not shrunk)", results)
         failed += not ok
         print(f"verdict: {'PASS' if ok else 'FAIL'} {path}")
     return 1 if failed else 0

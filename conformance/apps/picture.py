@@ -1,0 +1,159 @@
+"""The picture of an app's scene at the end of a run, taken in the app's process: FURY's and pyBullet's.
+
+At the end of every run (the app's own and each perturbed one) the kit draws the app's own actors, as
+its own ShowManager holds them, from the app's own camera (:mod:`conformance.apps.picture_vtk`,
+:mod:`conformance.apps.picture_pygfx`), each face flat in a colour that codes it, and pyBullet's tiny
+renderer draws its segmentation mask on the app's client from the same camera
+(:func:`conformance.rendering.silhouettes.pybullet_mask`, the scene checks' own). Which body a face
+draws is not known here: the judgement (:mod:`conformance.apps.pictured`) labels each face by the frame
+the attachment gives its first vertex. So the picture keeps, per pixel, the app-wide index of that
+vertex (actors in the recording's order, -1 for the background, -2 for a pixel whose colour is no code:
+a shader or texture the kit could not switch off).
+
+What the picture shows that the recorded vertices do not: an actor hidden (``SetVisibility(0)``,
+``visible = False``) or so transparent it changes no pixel by more than the golden check's 32 levels
+(:data:`FAINT`: faces drawn fainter are kept, flagged per vertex), and on FURY 2 the vertices the GPU
+holds: pygfx uploads only the ranges announced with ``update_range``, so the kit keeps, tick by tick,
+a copy of what the renderer would have uploaded (``_Track.gpu`` in :mod:`conformance.apps.driver`) and
+draws from it.
+
+Both pictures share one camera: the app's position, focal point, view up and vertical view angle at
+the aspect of the app's window, and a clipping range spanning every recorded vertex (so neither
+renderer clips what the other shows). The size is the app's window scaled to :data:`SIDE` pixels on
+its longer side, the scene checks' picture width, where their silhouette thresholds were measured.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, replace
+from types import SimpleNamespace
+
+import numpy as np
+
+__all__ = ["FAINT", "SIDE", "Camera", "picture_size", "take"]
+
+#: The longer side of the picture, in pixels: the scene checks' 450×384 pictures, whose silhouette
+#: thresholds (:data:`conformance.rendering.silhouettes.MIN_IOU`, ``MIN_PIXELS``) this reuses.
+SIDE = 450
+#: An opacity below this changes no pixel by more than 32 of 255 levels, the golden check's
+#: other-renderer threshold (:data:`conformance.rendering.compare.OTHER_RENDERER`): not shown.
+FAINT = 32 / 255
+
+
+@dataclass(frozen=True)
+class Camera:
+    """A perspective camera as :mod:`conformance.rendering.projection` takes it (vertical view angle, degrees)."""
+
+    position: tuple
+    focal_point: tuple
+    view_up: tuple
+    view_angle: float
+    clipping_range: tuple = (0.1, 100.0)
+
+    def as_dict(self) -> dict:
+        return {k: (list(v) if isinstance(v, tuple) else v) for k, v in asdict(self).items()}
+
+
+def picture_size(app_size) -> tuple[int, int]:
+    """The app's window ``(width, height)`` scaled to :data:`SIDE` pixels on its longer side."""
+    width, height = (max(1, int(v)) for v in app_size)
+    scale = SIDE / max(width, height)
+    return max(1, round(width * scale)), max(1, round(height * scale))
+
+
+def clipping_range(camera: Camera, points: np.ndarray) -> tuple[float, float]:
+    """Near and far planes around ``points`` (n, 3) seen from ``camera``: 10 % beyond the farthest, and
+    the nearest in front of the camera (at least 1/1000 of the far plane, a usable depth resolution)."""
+    from conformance.rendering import projection
+
+    view = projection.view_matrix(camera)
+    depth = -(points @ view[2, :3] + view[2, 3]) if len(points) else np.array([1.0])
+    far = max(float(depth.max()) * 1.1, 1e-3)
+    ahead = depth[depth > far * 1e-3]
+    near = max(float(ahead.min()) * 0.9 if len(ahead) else far * 1e-3, far * 1e-3)
+    return near, far
+
+
+def touching(client: int, frames) -> list[list[int]]:
+    """Pairs of frame indices pyBullet has within the silhouette check's
+    :data:`~conformance.rendering.silhouettes.TOUCHING` of each other now: the pixels where two renderers
+    may put either in front, which the comparison leaves out as the scene checks do. Candidates are the
+    frames whose bounding boxes overlap (``getOverlappingObjects``), each pair then measured with
+    ``getClosestPoints`` as :func:`~conformance.rendering.silhouettes.touching_pairs` does (contact points
+    would miss a link and its parent, which pyBullet does not collide)."""
+    import pybullet
+
+    from conformance.rendering.silhouettes import TOUCHING
+
+    index = {(f.body, f.link): i for i, f in enumerate(frames) if f.client == client}
+    pairs = set()
+    for (body, link), i in index.items():
+        low, high = pybullet.getAABB(body, link, physicsClientId=client)
+        near = pybullet.getOverlappingObjects(np.subtract(low, TOUCHING).tolist(), np.add(high, TOUCHING).tolist(),
+                                              physicsClientId=client) or []
+        for other in {(b, l) for b, l in near}:
+            j = index.get(other)
+            if j is None or j <= i:
+                continue
+            if pybullet.getClosestPoints(body, other[0], TOUCHING, linkIndexA=link, linkIndexB=other[1],
+                                         physicsClientId=client):
+                pairs.add((i, j))
+    return [list(p) for p in sorted(pairs)]
+
+
+def take(source, tracks, frames, clients, tick: int) -> dict:
+    """The pictures of the app's scene now (after tick ``tick``), as a dict the recording keeps: ``tick``,
+    ``size``, ``camera``, ``vertices`` (h, w) app-wide vertex index per pixel, ``bullet`` (h, w) frame index
+    per pixel (-1 none), ``faint`` and ``stale`` (one bool per app-wide vertex: drawn fainter than
+    :data:`FAINT`; held by the GPU elsewhere than its array), ``hidden`` (per actor), ``touching``,
+    ``notes``; or only ``tick`` and ``skipped`` (why no picture was taken)."""
+    from conformance.client import BoundClient
+    from conformance.rendering import silhouettes
+
+    viewed = getattr(source, "camera", None)
+    if viewed is None:
+        return {"tick": tick, "skipped": "the app's loop is its own function (--tick), with no ShowManager camera"}
+    camera, app_size, why = viewed()
+    if camera is None:
+        return {"tick": tick, "skipped": why}
+    size = picture_size(app_size)
+    points = np.concatenate([t.vertices[-1] for t in tracks]) if tracks else np.zeros((0, 3))
+    camera = replace(camera, clipping_range=clipping_range(camera, points))
+    drawn = source.faces([t.actor for t in tracks], camera, size, [t.gpu for t in tracks])
+    client = clients[0]
+    own = [i for i, f in enumerate(frames) if f.client == client]
+    bound = [SimpleNamespace(body=frames[i].body, link=frames[i].link) for i in own]
+    seen = silhouettes.pybullet_mask(SimpleNamespace(p=BoundClient(client)), bound, camera, size)
+    bullet = np.where(seen >= 0, np.asarray(own + [-1], dtype=np.int32)[seen], -1).astype(np.int32)
+    notes = list(drawn.get("notes", []))
+    if len(set(clients)) > 1:
+        notes.append(f"pyBullet drew client {client} only: bodies of the app's other clients are not in its picture")
+    return {"tick": tick, "size": list(size), "camera": camera.as_dict(), "vertices": drawn["vertices"],
+            "bullet": bullet, "faint": drawn["faint"], "stale": drawn["stale"], "hidden": drawn["hidden"],
+            "touching": touching(client, frames), "notes": notes}
+
+
+def view_angle(vertical: float | None = None, *, horizontal: float | None = None, aspect: float = 1.0) -> float:
+    """A vertical view angle in degrees, from itself or from a horizontal one at ``aspect`` = width / height."""
+    if vertical is not None:
+        return float(vertical)
+    return math.degrees(2 * math.atan(math.tan(math.radians(horizontal) / 2) / aspect))
+
+
+def face_codes(first_vertices: list[np.ndarray], vertex_offsets: list[int]) -> tuple[np.ndarray, np.ndarray]:
+    """Colours coding every face of every actor (:func:`conformance.backends.common.id_colors`), and
+    the app-wide vertex each code stands for (the face's first vertex)."""
+    from conformance.backends.common import id_colors
+
+    owners = np.concatenate([f + o for f, o in zip(first_vertices, vertex_offsets)]) if first_vertices else np.zeros(0, int)
+    return id_colors(len(owners)), owners.astype(np.int64)
+
+
+def decode(picture: np.ndarray, owners: np.ndarray) -> np.ndarray:
+    """``(h, w)`` app-wide vertex index of the face seen at each pixel of a face-coded ``picture``."""
+    from conformance.backends.common import decode_ids
+
+    faces = decode_ids(picture, len(owners), strict=False)
+    table = np.concatenate([owners, [-2, -1]]).astype(np.int32)  # faces[...] == -2 → -2, -1 → -1
+    return table[np.where(faces >= 0, faces, len(owners) + faces + 2)]
