@@ -23,7 +23,7 @@ def add_arguments(parser) -> None:
                         "a tick, for an app whose loop is its own")
     parser.add_argument("--timeout", default="300", metavar="S", help="seconds one run of the app may take (default 300)")
     parser.add_argument("--results", default=None, metavar="DIR", help="where a failing picture check writes its "
-                        "pictures and every picture's record (default: the scene checks' results directory)")
+                        "pictures and their records (default: the scene checks' results directory, conformance-results)")
 
 
 def _print_result(result, label: str, results=None) -> None:
@@ -37,11 +37,11 @@ def _print_result(result, label: str, results=None) -> None:
             print(f"      {line}")
         if len(verdict.lines) > 12:
             print(f"      … {len(verdict.lines) - 12} more lines")
-        if check == "pictured" and results is not None:
+        if check == "pictured" and results is not None and not verdict.passed:  # nothing written for a pass
             from conformance.apps import pictured
 
             written = pictured.keep(verdict, results, result.reproduce())
-            if written and not verdict.passed:
+            if written:
                 print(f"      pictures (under {results}): {', '.join(written[:3])}"
                       + (f" and {len(written) - 3} more" if len(written) > 3 else ""))
     if not result.passed:
