@@ -311,12 +311,16 @@ class _Track:
         self._state = state
         taken = self.backend.hand_over(self.actor)  # as the window's next frame would, so the next tick starts clean
         if taken is not None:
-            self._keep_gpu(taken.get("positions", []))
+            self._keep_gpu(taken.get("positions"))
 
     def _keep_gpu(self, chunks) -> None:
         """Copy what the renderer would upload of the positions now (whole chunks, as announced): the
-        GPU's vertices, which the picture check draws (:mod:`conformance.apps.picture`)."""
+        GPU's vertices, which the picture check draws (:mod:`conformance.apps.picture`). None when the
+        positions are on the GPU itself: the picture then draws them from there."""
         data = np.asarray(self.actor.geometry.positions.data)
+        if chunks is None:
+            self.gpu = None
+            return
         if self.gpu is None or self.gpu.shape != data.shape:
             self.gpu = np.array(data, copy=True)  # a new buffer is uploaded whole
             return

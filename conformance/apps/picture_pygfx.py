@@ -6,7 +6,10 @@ twin of each judged mesh: its index buffer, its world matrix, its visibility (an
 face culling, unlit, each face flat in a code colour. Its positions are what the GPU would hold: pygfx
 uploads only the chunks announced with ``update_range``/``update_full``, and the kit keeps a copy of
 exactly those, tick by tick (``_Track.gpu``), so a change written but announced for the wrong range is
-drawn where the GPU still has it, as the app's own window would draw it. The app's meshes are not touched.
+drawn where the GPU still has it, as the app's own window would draw it. A buffer the app itself put on
+the GPU (it drew, or flushed as the kit's scene runner does) is shared instead: the kit uploads its
+announced ranges after each tick as a window would, so it holds what the window would draw. The app's
+meshes are not touched.
 """
 
 from __future__ import annotations
@@ -68,9 +71,10 @@ def faces(showm, actors, cam, size, gpu) -> dict:
     stale, start = [], 0
     for actor, faces_of, held in zip(actors, triangles, gpu):
         data = np.asarray(actor.geometry.positions.data)
-        on_gpu = data if held is None or held.shape != data.shape else held
-        stale.append(np.any(on_gpu != data, axis=-1).reshape(-1))
-        positions = actor.geometry.positions if on_gpu is data else pygfx.Buffer(np.ascontiguousarray(on_gpu, np.float32))
+        # On the GPU already (drawn or flushed by the app): the buffer itself is what the GPU holds.
+        live = held is None or held.shape != data.shape or actor.geometry.positions._wgpu_object is not None
+        stale.append(np.zeros(len(data), bool) if live else np.any(held != data, axis=-1).reshape(-1))
+        positions = actor.geometry.positions if live else pygfx.Buffer(np.ascontiguousarray(held, np.float32))
         codes = backend._linear(colours[start:start + len(faces_of)])
         start += len(faces_of)
         geometry = pygfx.Geometry(indices=actor.geometry.indices, positions=positions, colors=pygfx.Buffer(codes))

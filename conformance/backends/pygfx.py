@@ -182,8 +182,19 @@ def hand_over(actor) -> None:
     calls this after every tick, where the app's own window does not draw.
 
     Returns, per buffer name, the ``(offset, size)`` item ranges taken: what the renderer would upload,
-    whole chunks of them, so app mode keeps a copy of what the GPU holds (:mod:`conformance.apps.picture`)."""
-    return {name: [tuple(d[:2]) for d in buffer._gfx_get_chunk_descriptions()] for name, buffer in _buffers(actor)}
+    whole chunks of them, so app mode keeps a copy of what the GPU holds (:mod:`conformance.apps.picture`).
+    A buffer already on the GPU (the app, or a kit scene's runner, drew or flushed it) gets its ranges
+    uploaded as :func:`flush` does, and None: the GPU itself holds what was announced."""
+    from pygfx.renderers.wgpu.engine.update import update_resource
+
+    taken = {}
+    for name, buffer in _buffers(actor):
+        if buffer._wgpu_object is not None:
+            update_resource(buffer)
+            taken[name] = None
+        else:
+            taken[name] = [tuple(d[:2]) for d in buffer._gfx_get_chunk_descriptions()]
+    return taken
 
 
 def content_time(actor) -> int:
