@@ -178,7 +178,7 @@ def test_a_ball_outline_a_pixel_wider_is_the_tessellation_slack_but_four_are_not
 
 
 #: Per FURY, an example app whose every recorded vertex is right and whose picture is not.
-PICTURE_ONLY = {"vtk": "brick_wall_fades_in.py", "pygfx": "brick_wall_single_announces_last_brick.py"}
+PICTURE_ONLY = {"vtk": "brick_wall_fades_in.py", "pygfx": "brick_wall_fades_in.py"}
 
 
 @pytest.mark.parametrize("ticks", [90])
@@ -193,7 +193,7 @@ def test_only_the_picture_check_sees_the_example_mistake(ticks, tmp_path):
     failing = {c for c, v in result.verdicts.items() if not v.passed}
     assert failing == {"pictured"}, {c: result.verdicts[c].message()[:500] for c in failing}
     verdict = result.verdicts["pictured"]
-    assert verdict.diagnoses and set(verdict.diagnoses) == {"hidden" if backends.NAME == "vtk" else "stale-gpu"}
+    assert verdict.diagnoses and set(verdict.diagnoses) == {"hidden"}
     assert f"tick {ticks}: body " in verdict.lines[0]
     written = pictured.keep(verdict, tmp_path, result.reproduce())
     assert {Path(w).name.rsplit("-", 1)[-1] for w in written} == {"fury_mask.png", "pybullet_mask.png", "mask_difference.png"}
