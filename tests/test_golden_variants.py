@@ -25,13 +25,15 @@ SHARED_ONLY = ["wrong_syncs:NormalsNotRotated", "wrong_syncs:ForgetsModified"] +
 
 
 def render_verdicts(spec: str, scene: str, params: dict) -> list:
-    """The golden render verdict of every golden frame of ``scene`` drawn with ``params`` by ``spec``,
-    against the default goldens, under the same-renderer set (the tightest: a variant must equal them)."""
+    """Both picture verdicts of every golden frame of ``scene`` drawn with ``params`` by ``spec``, against
+    the default goldens and a live reference drawn the same way, under the same-renderer set (the
+    tightest: a variant must equal them)."""
     with runner.running(scene, sync.load(spec), **params) as run:
         defaults = scenes.get(scene).defaults
         goldens = [snapshots.load(golden.default_dir(), run.scene, f, params=defaults)
                    for f in scenes.get(scene).frames_with_goldens()]
-        return [snapshots.check_render(run, g, compare.SAME_RENDERER, sync=spec)[0] for g in goldens]
+        return [snapshots.check_render(run, g, sync=spec, here=backends.renderer_info(), override=compare.SAME_RENDERER.name)[0]
+                for g in goldens]
 
 
 def test_there_is_a_variant_with_shared_spheres():
