@@ -54,6 +54,8 @@ def main(argv: list[str] | None = None) -> int:
     commands = _commands()
     parser = _parser(commands)
     args, extra = parser.parse_known_args(argv)
+    if "--" in extra:  # `kill-rate … -- -k chain`: what follows is pytest's, and "--" itself would end pytest's options
+        extra.remove("--")
     command = commands[args.command]
     if extra and not getattr(command, "TAKES_PYTEST_ARGS", False):
         parser.error(f"unrecognized arguments: {' '.join(extra)}")

@@ -316,3 +316,14 @@ def test_argparse_type_gives_argparse_s_one_line_error(capsys):
         parser.parse_args(["--jobs", "0"])
     assert info.value.code == 2
     assert "error: argument --jobs: --jobs=0 (int), but should be a whole number from 1 to 256." in capsys.readouterr().err
+
+
+def test_what_follows_a_double_dash_goes_to_pytest_as_options(tmp_path):
+    # `run -- -k X`: pytest must get `-k X`, not `-- -k X` (which makes "-k" a file to collect).
+    import subprocess
+    import sys
+
+    done = subprocess.run([sys.executable, "-m", "conformance", "run", "--", "-k", "test_no_stale_goldens", "--collect-only",
+                           "-q"], cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
+    assert "1/" in done.stdout and "tests collected" in done.stdout, done.stdout[-1000:]
