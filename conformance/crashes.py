@@ -187,6 +187,19 @@ class Controller:
                                   "frame": step, "target": None, "message": message.splitlines()[0],
                                   "failures": 1}},
             "message": message.splitlines()[0], "diagnosis": ""}))
+        self._report_row(crashitem, scene, step, message)
+
+    def _report_row(self, crashitem: str, scene, step, message: str) -> None:
+        """The crash as a row of ``report.html`` (kind ``crashed``, no pictures: the process that would
+        have drawn them is gone), written by the controller, which outlives it."""
+        from conformance import image_options
+        from conformance.rendering import artefacts
+        from conformance.rendering.records import ImageCheck
+
+        reproduce = next((line.split(": ", 1)[1] for line in message.splitlines() if line.startswith("reproduce")), "")
+        record = ImageCheck(kind="crashed", scene=scene or "?", frame=step if isinstance(step, int) else -1, passed=False,
+                            message=message, sync=self.sync_spec, reproduce=reproduce, nodeid=crashitem)
+        artefacts.append_record(record, image_options.from_config(self.config).results)
 
     def _read_where(self, worker: str, crashitem: str) -> dict:
         try:

@@ -82,6 +82,9 @@ def test_a_segfault_fails_its_check_with_where_it_was_and_the_run_goes_on(run, w
     assert f"FAIL  {SCENE}" in text and "PASS  sliding_box" in text, text
     page = text.split("conformance: report (image checks, failing vertex checks): ")[1].split()[0]
     assert Path(page).is_file(), f"{page}, but the run's report.html was not written"
+    html = Path(page).read_text(encoding="utf-8")
+    assert 'data-kind="crashed"' in html and "the process crashed (killed by SIGSEGV)" in html, \
+        "the crash is not a row of report.html"
 
 
 @pytest.mark.parametrize("sync, how", [("AbortsOnFreeFall", "killed by SIGABRT"),

@@ -17,7 +17,7 @@ __all__ = ["GOLDEN_VERDICTS", "ImageCheck"]
 #: (``user_properties``), for the plugin's JSON (:mod:`.reftest`).
 GOLDEN_VERDICTS = "conformance_golden_verdicts"
 #: The kinds of image check.
-KINDS = ("vertices", "golden", "silhouette", "framing")
+KINDS = ("crashed", "vertices", "golden", "silhouette", "framing")
 
 
 @dataclass
@@ -26,7 +26,8 @@ class ImageCheck:
 
     ``kind``: ``golden`` (a render against a committed golden), ``silhouette`` (FURY's silhouette of
     each target against pyBullet's own renderer), ``framing`` (every body on screen and large enough),
-    ``vertices`` (a vertex check's failing frame, pictured with pyBullet's outline: :mod:`.misplaced`).
+    ``vertices`` (a vertex check's failing frame, pictured with pyBullet's outline: :mod:`.misplaced`),
+    ``crashed`` (a check whose process the sync crashed: the paragraph and the native stack, no picture).
     ``metrics`` are the measured numbers and ``limits`` the bounds they were held to, by the same keys
     where a key has a bound (e.g. ``differing_fraction`` ≤ ``limits["differing_fraction"]``; for a
     silhouette, ``iou`` of the worst target ≥ ``limits["iou"]``). ``images`` maps a role (``expected``,
