@@ -38,3 +38,18 @@ def test_idle_checks_and_single_points_are_listed():
     assert "- `test_c`: **no reason written: strengthen it or say why it stays**" in text, text
     assert "- `test_engine_defaults`: judges pyBullet's integrator" in text, text
     assert "- `w:Lonely`: only `test_b`" in text, text
+
+
+def test_the_command_writes_the_matrix_with_the_command_that_made_it(tmp_path, monkeypatch):
+    from conformance import cli, verdicts
+
+    monkeypatch.setattr(verdicts, "implementations", lambda module: [f"{module}:A"])
+    monkeypatch.setattr(verdicts, "what_it_is", lambda spec: spec)
+    monkeypatch.setattr(verdicts, "check_all", lambda specs, **kwargs: [
+        Outcome(s, 1 if "wrong" in s else 0, [_record("test_a", "failed" if "wrong" in s else "passed")]) for s in specs])
+    out = tmp_path / "matrix.md"
+    status = cli.main(["kill-rate", "--wrong", "wrong_mod", "--right", "right_mod", "--matrix", str(out), "--", "-k", "chain"])
+    assert status == 0
+    text = out.read_text(encoding="utf-8")
+    assert f"Made by `python -m conformance kill-rate --wrong wrong_mod --right right_mod --matrix {out} -- -k chain`" in text
+    assert "| `wrong_mod:A` | ✕ | 1 |" in text, text
