@@ -23,6 +23,7 @@ FIRST = (
     "test_sync_does_not_touch_physics",
     "test_syncing_every_frame_equals_syncing_once",
     "test_drawn_bounds_agree_with_get_aabb",
+    "test_sync_order_follows_any_order_of_calls",
     "test_silhouettes_match_pybullet_at_golden_frames",
     "test_silhouettes_match_in_any_orientation",
     "test_same_scene_renders_identically",

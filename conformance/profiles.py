@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from hypothesis import HealthCheck, Phase, settings
 
-__all__ = ["CI_FACTOR", "app_examples", "check_settings", "describe", "shrinks"]
+__all__ = ["CI_FACTOR", "STATEFUL_STEPS", "app_examples", "check_settings", "describe", "shrinks", "stateful_steps"]
 
 CI_FACTOR = 4
 _SLOW_OK = [HealthCheck.too_slow, HealthCheck.data_too_large, HealthCheck.filter_too_much]
@@ -65,6 +65,18 @@ _APP_EXAMPLES = {"default": 2, "ci": 3, "triage": 2}
 def app_examples() -> int:
     """How many perturbed runs ``test_app_perturbed`` makes of each app under the current profile."""
     return _APP_EXAMPLES.get(_profile(), settings.default.max_examples)
+
+
+#: Calls per program of the sync-order state machine (conformance/test_sync_order.py) under the kit's
+#: profiles: a few syncs after each kind of change. Its programs scale with the profile like every
+#: check's examples; this bounds each one (docs/numbers.md, "Sync order": 4.1 % of a ci run).
+STATEFUL_STEPS = 30
+
+
+def stateful_steps() -> int:
+    """``stateful_step_count`` of the sync-order state machine: :data:`STATEFUL_STEPS` under the kit's
+    profiles, the profile's own under any other."""
+    return STATEFUL_STEPS if _profile() in _FACTORS else settings.default.stateful_step_count
 
 
 def describe() -> str:
