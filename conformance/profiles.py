@@ -69,7 +69,7 @@ def app_examples() -> int:
 
 #: Calls per program of the sync-order state machine (conformance/test_sync_order.py) under the kit's
 #: profiles: a few syncs after each kind of change. Its programs scale with the profile like every
-#: check's examples; this bounds each one (docs/numbers.md, "Sync order": 4.1 % of a ci run).
+#: check's examples; this bounds each one (docs/numbers.md, "Sync order": 4-7 % of a ci run).
 STATEFUL_STEPS = 30
 
 
