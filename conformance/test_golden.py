@@ -116,10 +116,7 @@ def test_no_stale_goldens(pictures):
     """Every file in the golden directories of this run's scenes is a golden that a check reads."""
     from conformance.rendering import golden
 
-    by_directory: dict = {}
-    for name in scenes.names():
-        by_directory.setdefault(pictures.golden_dir_for(name), {})[name] = scenes.get(name).frames_with_goldens()
-    found = [path for directory, wanted in by_directory.items() for path in golden.stale(directory, wanted)]
+    found = [path for paths in golden.stale_by_directory(pictures.golden_dir_for).values() for path in paths]
     if found:
         given = ["--golden-dir", str(pictures.golden_dir)] if pictures.golden_dir is not None else []
         pytest.fail(f"{len(found)} file(s) in the golden directories are read by no check (a scene removed or renamed, "

@@ -4,6 +4,8 @@ golden new, changed (both written), unchanged, or kept (only float noise in its 
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from conformance import validation
 
 NAME = "regen"
@@ -52,23 +54,20 @@ def _prune(given, directories: set) -> int:
     """Delete :func:`conformance.rendering.golden.stale` files of each of ``directories``, then its emptied
     folders. What a directory must keep is every registered scene's goldens there, not only the scenes
     named: ``regen --prune chain`` prunes chain's directory and never deletes another scene's goldens."""
-    from conformance import own_scenes, scenes
+    from conformance import own_scenes
     from conformance.rendering import golden
 
-    by_directory: dict = {directory: {} for directory in directories}
-    for name in scenes.names():
-        directory = given if given is not None else own_scenes.golden_dir(name)
-        if directory in by_directory:
-            by_directory[directory][name] = scenes.get(name).frames_with_goldens()
+    stale = golden.stale_by_directory(lambda name: given if given is not None else own_scenes.golden_dir(name))
+    chosen = {Path(d) for d in directories}
     deleted = 0
-    for directory, wanted in by_directory.items():
-        for path in golden.stale(directory, wanted):
+    for directory in chosen:
+        for path in stale.get(directory, []):
             path.unlink()
             deleted += 1
             print(f"deleted {path}")
         for folder in sorted((p for p in directory.rglob("*") if p.is_dir()), key=lambda p: len(p.parts), reverse=True):
             if not any(folder.iterdir()):
                 folder.rmdir()
-    where = ", ".join(str(d) for d in by_directory)
+    where = ", ".join(str(d) for d in chosen)
     print(f"goldens in {where}: {deleted} file(s) no check reads deleted")
     return 0

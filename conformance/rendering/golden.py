@@ -27,14 +27,14 @@ import shlex
 import zlib
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Iterable
+from typing import Any, Callable, Iterable
 
 import numpy as np
 
 from conformance.errors import GoldenMissing, GoldenUnreadable
 from conformance.files import encode_png, write_atomically
 
-__all__ = ["FORMAT", "Golden", "default_dir", "encode_manifest", "jsonable", "library_versions", "paths", "read", "regen_command", "stale", "write"]
+__all__ = ["FORMAT", "Golden", "default_dir", "encode_manifest", "jsonable", "library_versions", "paths", "read", "regen_command", "stale", "stale_by_directory", "write"]
 
 #: The manifest format; bumped when its meaning changes, so an old manifest is refused, not misread.
 FORMAT = 1
@@ -64,6 +64,17 @@ def stale(directory: Path | str, wanted: dict[str, Iterable[int]]) -> list[Path]
         return []
     used = {p for scene, frames in wanted.items() for frame in frames for p in paths(directory, scene, frame)}
     return sorted(p for p in directory.rglob("*") if p.is_file() and p not in used)
+
+
+def stale_by_directory(directory_for: Callable[[str], Path]) -> dict[Path, list[Path]]:
+    """:func:`stale` files of every golden directory of the registered scenes (``directory_for(name)``
+    says where a scene's goldens live): a directory keeps the goldens of every scene it holds."""
+    from conformance import scenes
+
+    wanted: dict[Path, dict[str, Iterable[int]]] = {}
+    for name in scenes.names():
+        wanted.setdefault(Path(directory_for(name)), {})[name] = scenes.get(name).frames_with_goldens()
+    return {directory: stale(directory, frames) for directory, frames in wanted.items()}
 
 
 def regen_command(scene: str, directory: Path | str | None = None) -> str:
