@@ -14,7 +14,8 @@ TAKES_PYTEST_ARGS = True
 
 
 def add_arguments(parser) -> None:
-    parser.add_argument("--wrong", required=True, type=argparse_type(module_name, "--wrong"), help="module whose classes are wrong sync implementations")
+    parser.add_argument("--wrong", required=True, action="append", type=argparse_type(module_name, "--wrong"),
+                        help="module whose classes are wrong sync implementations (repeat for several)")
     parser.add_argument("--right", required=True, type=argparse_type(module_name, "--right"), help="module whose classes are right sync implementations")
     parser.add_argument("--out", type=argparse_type(file_to_write, "--out"), default=None, help="also write the markdown here")
     parser.add_argument("--matrix", type=argparse_type(file_to_write, "--matrix"), default=None, metavar="OUT.md",
@@ -28,7 +29,8 @@ def add_arguments(parser) -> None:
 def run(args, extra) -> int:
     from conformance import backends, verdicts
 
-    wrong, right = verdicts.implementations(args.wrong), verdicts.implementations(args.right)
+    wrong = [spec for module in args.wrong for spec in verdicts.implementations(module)]
+    right = verdicts.implementations(args.right)
     # A wrong implementation needs only its first failure, unless the matrix asks for every check's verdict;
     # a right one must pass everything.
     outcomes = verdicts.check_all(wrong, stop_at_first=not args.matrix, survey=bool(args.matrix), pytest_args=extra,
@@ -43,7 +45,7 @@ def run(args, extra) -> int:
 
         import shlex
 
-        made_by = shlex.join(["python", "-m", "conformance", "kill-rate", "--wrong", args.wrong, "--right", args.right,
+        made_by = shlex.join(["python", "-m", "conformance", "kill-rate", *[part for module in args.wrong for part in ("--wrong", module)], "--right", args.right,
                               "--matrix", str(args.matrix), *(["--", *extra] if extra else [])])
         text_matrix = f"# Kill matrix, {backends.describe()}\n\nMade by `{made_by}`.\n\n{kill_matrix.markdown(outcomes)}\n"
         write_atomically(args.matrix, text_matrix.encode("utf-8"))
