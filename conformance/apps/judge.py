@@ -385,7 +385,8 @@ class _Judgement:
             reference = np.median(local, axis=0)
             reference /= np.maximum(np.linalg.norm(reference, axis=1, keepdims=True), 1e-12)
             angle = np.arccos(np.clip(np.einsum("tni,ni->tn", local, reference), -1, 1))
-            worst = max(worst, float(angle.max(initial=0)) / self.tolerance.normal_angle)
+            # Vertices no frame holds fail `attached`; their normals have no frame to turn with.
+            worst = max(worst, float(angle[:, a.held].max(initial=0)) / self.tolerance.normal_angle)
             bad = np.any(angle > self.tolerance.normal_angle, axis=0) & a.held
             for start, stop in _runs(bad, frames):
                 verdict.passed = False
