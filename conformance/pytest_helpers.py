@@ -20,12 +20,16 @@ from typing import Any, Callable, Iterable, Iterator, Mapping, Sequence
 
 import pytest
 
-from conformance import compare, diagnosis, events as events_module, scenes, survey as survey_module
+from conformance import compare, diagnosis, events as events_module, profiles, scenes, survey as survey_module
 from conformance.errors import SyncError
 from conformance.survey import WORST  # noqa: F401  (where the plugin and older callers find it)
 from conformance.tolerances import Tolerance
 
+#: The label of the vertex checks' ``hypothesis.target``: the worst vertex error over its tolerance.
+VERTEX_TARGET = "worst vertex error / tolerance"
+
 __all__ = [
+    "VERTEX_TARGET",
     "Kit",
     "assert_geometry_matches",
     "assert_vertices_match",
@@ -208,6 +212,8 @@ class Kit:
         if survey:
             self.survey = survey_module.Survey() if node is None else node.stash.setdefault(
                 survey_module.SURVEY, survey_module.Survey())
+        #: The worst vertex error in tolerances since :meth:`aiming` began: how close the example came to failing.
+        self.closest = 0.0
         # run -> how many of its unannounced changes are noted; weak, so a later run never inherits a count
         self._announced: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
@@ -218,11 +224,23 @@ class Kit:
     def run(self, scene: str, events: Sequence = (), **params: Any):
         return sync_run(scene, self.implementation, events=events, **params)
 
+    @contextlib.contextmanager
+    def aiming(self, label: str = VERTEX_TARGET) -> Iterator[None]:
+        """Around one Hypothesis example: the worst vertex error it saw, in tolerances, becomes its
+        ``hypothesis.target`` (:func:`conformance.profiles.aim`) when it ends without failing."""
+        self.closest = 0.0
+        yield
+        profiles.aim(self.closest, label)
+
     def _record(self, results: Sequence[Any]) -> None:
-        if self._node is None or not results:
+        if not results:
             return
         worst = max(results, key=_by_ratio)
         ratio = worst.error / worst.tolerance if worst.tolerance else worst.error
+        if not self.closest >= ratio:  # NaN wins
+            self.closest = ratio
+        if self._node is None:
+            return
         best = self._node.stash.get(WORST, None)
         if best is None or not (best["ratio"] >= ratio):  # NaN ratios win
             self._node.stash[WORST] = {"ratio": ratio, "error": worst.error, "tolerance": worst.tolerance,
@@ -250,7 +268,15 @@ class Kit:
             self._failed("vertices", lambda w=worst: _vertices_message(failures, run, sync, w, drawn()),
                          first=(lambda: first) if first is not None else (lambda: _vertices_message(failures, run, sync, drawn=drawn())),
                          value=worst.error, limit=worst.tolerance, unit="m", frame=worst.frame, target=worst.target)
-        turned = [r for r in compare.compare_normals(run.drawing, run.frame, self.tolerance) if not r.ok]
+        normals = compare.compare_normals(run.drawing, run.frame, self.tolerance)
+        if normals and self._node is not None:
+            worst = max(normals, key=lambda r: r.angle / r.tolerance)
+            best = self._node.stash.get(survey_module.WORST_NORMALS, None)
+            if best is None or not (best["ratio"] >= worst.angle / worst.tolerance):  # NaN wins
+                self._node.stash[survey_module.WORST_NORMALS] = {
+                    "ratio": worst.angle / worst.tolerance, "error": worst.angle, "tolerance": worst.tolerance,
+                    "target": worst.target, "frame": worst.frame}
+        turned = [r for r in normals if not r.ok]
         if turned:
             worst = max(turned, key=lambda r: (r.angle / r.tolerance if r.tolerance else r.angle))
             self._failed("normals", lambda: _normals_message(turned, run, sync), value=worst.angle,

@@ -19,10 +19,10 @@ import pytest
 from hypothesis import settings, strategies as st
 from hypothesis.stateful import RuleBasedStateMachine, initialize, invariant, precondition, rule, run_state_machine_as_test
 
-from conformance import strategies, survey
+from conformance import profiles, strategies, survey
 from conformance.events import JointReset, Kick, Teleport
 from conformance.profiles import check_settings, stateful_steps
-from conformance.pytest_helpers import Kit, _context
+from conformance.pytest_helpers import VERTEX_TARGET, Kit, _context
 
 #: Scenes with a multibody's links (pendulum, wrecking_ball), shared actors (domino, wrecking_ball),
 #: static bodies (all four) and bases with an inertial offset (weighted).
@@ -79,6 +79,7 @@ def machine(kit: Kit, scene_name: str) -> type[RuleBasedStateMachine]:
             self._context = None
             self.calls: list[str] = []  # the program so far, for the failure message
             self.fresh = False  # synced since pyBullet last changed
+            checker.closest = 0.0
 
         # -- the failure message -----------------------------------------------------------------
         def fail(self, kind: str, message: str) -> None:
@@ -197,6 +198,7 @@ def machine(kit: Kit, scene_name: str) -> type[RuleBasedStateMachine]:
         def teardown(self):
             if self._context is not None:
                 self._context.__exit__(None, None, None)
+            profiles.aim(checker.closest, VERTEX_TARGET)
 
     SyncOrder.__name__ = SyncOrder.__qualname__ = f"SyncOrder_{scene_name}"
     return SyncOrder

@@ -33,3 +33,35 @@ def test_a_counter_example_is_shrunk_only_where_the_profile_says(pytester, profi
     assert ("counter-example not shrunk" in out) == (not shrunk), out[-2000:]
     if not shrunk:
         assert "--hypothesis-profile shrink" in out
+
+
+def test_each_example_reports_how_close_it_came_to_failing(monkeypatch):
+    """``Kit.aiming`` hands Hypothesis the worst vertex error of the example in tolerances: near zero
+    for the reference, a real fraction for float32 increments; never from outside an example, never a NaN."""
+    from hypothesis import given, settings, strategies as st
+
+    from conformance import profiles, sync
+    from conformance.pytest_helpers import VERTEX_TARGET, Kit
+    from conformance.test_vertices import check_run
+    from conformance.tolerances import DEFAULT
+
+    seen: list[tuple[float, str]] = []
+    monkeypatch.setattr(profiles, "target", lambda value, label: seen.append((value, label)))
+    profiles.aim(0.5, "outside")  # not in an example: nothing
+    profiles.aim(float("nan"), "nan")
+
+    def closest(spec: str) -> float:
+        seen.clear()
+
+        @settings(max_examples=1, database=None, deadline=None)
+        @given(st.just(None))
+        def example(_):
+            check_run(Kit(sync.load(spec), DEFAULT), "chain", {}, 8)
+
+        example()
+        [(value, label)] = seen
+        assert label == VERTEX_TARGET
+        return value
+
+    assert closest("reference") < 0.01
+    assert 0.05 < closest("wrong_syncs:Float32Incremental") < 1.0  # drifting, not yet failing
