@@ -392,6 +392,7 @@ def pytest_runtest_makereport(item: pytest.Item, call):
             "outcome": "xfailed" if hasattr(report, "wasxfail") and report.skipped else report.outcome,
             "verdict": report.outcome,
             "worst": item.stash.get(survey.WORST, None),
+            "worst_normals": item.stash.get(survey.WORST_NORMALS, None),
             "kinds": survey.kinds_of(item, report, message),
             "message": message.strip().splitlines()[0][:4000] if message.strip() else "",
             # test_golden_render: each golden frame's sync and renderer verdicts (conformance.rendering.reftest).

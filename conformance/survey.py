@@ -34,6 +34,7 @@ __all__ = [
     "SURVEY",
     "Survey",
     "WORST",
+    "WORST_NORMALS",
     "enabled",
     "figure",
     "figure_from_message",
@@ -48,6 +49,8 @@ __all__ = [
 
 #: The worst vertex error a check measured (failing or not), for the verdict table's ✓ cells.
 WORST = pytest.StashKey[dict]()
+#: The worst vertex-normal angle a check saw, in its tolerance (:mod:`conformance.tolerance_use`).
+WORST_NORMALS = pytest.StashKey[dict]()
 #: The survey of a check running in survey mode.
 SURVEY = pytest.StashKey["Survey"]()
 

@@ -38,6 +38,8 @@ class Outcome:
     exitstatus: int
     records: list[dict] = field(default_factory=list)
     stderr: str = ""
+    #: The run's image-check records (:class:`conformance.rendering.records.ImageCheck`, as dicts).
+    images: list[dict] = field(default_factory=list)
 
     @property
     def failed(self) -> list[dict]:
@@ -109,7 +111,12 @@ def check(spec: str, *, stop_at_first: bool = False, survey: bool = False, pytes
             return Outcome(spec, proc.returncode, [], (proc.stderr or proc.stdout)[-1500:])
         with open(report, encoding="utf-8") as fh:
             data = json.load(fh)
-        return Outcome(spec, proc.returncode, data["records"], proc.stderr[-1500:])
+        import dataclasses
+
+        from conformance.rendering.artefacts import read_records
+
+        images = [dataclasses.asdict(r) for r in read_records(os.path.join(tmp, "results"))]
+        return Outcome(spec, proc.returncode, data["records"], proc.stderr[-1500:], images)
 
 
 def check_all(specs: list[str], *, stop_at_first: bool = False, survey: bool = False, pytest_args: list[str] = (),
