@@ -111,6 +111,41 @@ def test_pixels_of_a_frame_the_kit_does_not_judge_are_left_out():
     assert verdict.passed, verdict.message()
 
 
+def test_a_body_drawn_only_as_another_shape_is_held_to_pyBullets_picture():
+    """Every drawing of the box is half its size (FURY 0.12's own chain demo draws its 1 m discs as thin
+    rods): placed cannot judge it, but the picture must still show what pyBullet simulates."""
+    pos, orn = motion()
+    small = [track(draw(pos, orn, CORNERS / 2))]
+    verdict = _judged([_shot(_labels(_square(top=15, left=15, side=10), 0), _labels(_square(), 0))], tracks=small)
+    assert not verdict.passed and verdict.diagnoses == ["not-its-shape"], verdict.message()
+    drawn_right = _judged([_shot(_labels(_square(), 0), _labels(_square(), 0))], tracks=small)
+    assert drawn_right.passed, drawn_right.message()
+
+
+def test_a_decoration_beside_a_drawing_of_the_shape_leaves_the_body_out_of_the_picture():
+    pos, orn = motion()
+    tracks = [track(draw(pos, orn)), track(draw(pos, orn, CORNERS / 2), label="marker_actor")]
+    fury = _labels(_square(), 0)
+    fury[5:10, 5:10] = 8  # the marker's first vertex, where pyBullet shows nothing
+    verdict = _judged([_shot(fury, _labels(_square(), 0), vertices=16, hidden=(False, False))], tracks=tracks)
+    assert verdict.passed, verdict.message()
+
+
+def test_a_decoration_pyBullet_does_not_have_hides_nothing_that_counts():
+    """FURY's own demos add ``actor.axes()`` at the origin: held by the world, drawn in front of a body
+    pyBullet shows whole. What it hides cannot be told, so its pixels are left out."""
+    pos, orn = motion()
+    still = (np.zeros_like(pos), np.tile([0.0, 0.0, 0.0, 1.0], (len(pos), 1)))
+    tracks = [track(draw(pos, orn)), track(draw(*still), label="axes_actor")]
+    fury = _labels(_square(), 0)
+    fury[10:20, 10:20] = 8  # the axes' first vertex, in front of a quarter of the box
+    verdict = _judged([_shot(fury, _labels(_square(), 0), vertices=16, hidden=(False, False))], tracks=tracks)
+    assert verdict.passed, verdict.message()
+    missing = _labels(_square(), 0)
+    missing[10:20, 10:20] = -1  # nothing drawn there: the box is missing a quarter
+    assert not _judged([_shot(missing, _labels(_square(), 0), vertices=16, hidden=(False, False))], tracks=tracks).passed
+
+
 def test_pairs_in_contact_may_be_in_front_of_each_other_in_either_picture():
     pos, orn = motion()
     other = box_frame(1)

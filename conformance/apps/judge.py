@@ -53,6 +53,9 @@ DIAGNOSES = {name: text for name, (text, _) in attach_mod.VARIANTS.items()} | {
                     "velocity to zero (pybullet 3.2.7), so the simulation is changed; a sync only reads",
     "hidden": "its actor is hidden (SetVisibility(0) on FURY 0.12, visible = False on FURY 2) or drawn fainter than "
               "opacity 32/255, so the picture does not show a body pyBullet has there: keep each body's actor shown",
+    "not-its-shape": "nothing draws the shape pyBullet simulates for this body: every drawing it holds is another "
+                     "shape (another size, or turned) than its collision shape, and the picture differs from "
+                     "pyBullet's own: build the actor from the collision shape's dimensions and orientation",
     "stale-gpu": "the GPU still holds older vertices of this body: the vertices were written but the range announced "
                  "with positions.update_range(offset, count) does not cover them (offset and count are in vertices); "
                  "announce every range written, or update_full()",

@@ -13,12 +13,13 @@ where two bodies in contact meet left out).
 Which frames are judged, and what the others are:
 
 * a frame whose drawing ``placed`` judged (its vertices span its one box, sphere or cylinder) is
-  judged, by its kind's threshold;
+  judged, by its kind's threshold; so is a frame of one such shape whose every drawing ``placed``
+  refused as another shape (nothing draws what pyBullet simulates: diagnosis ``not-its-shape``);
 * the world and static bodies (mass 0) are background in both pictures: an app may draw them as part
   of the world (a ground plate, a static decoration) or not at all, as the vertex checks allow; where
   such a thing is drawn in front of a body it hides it in both pictures alike, or, if it has no body in
   pyBullet, counts against that body (the picture does not show it);
-* every other frame — a decoration ``placed`` did not judge, a body nothing draws (the ``drawn``
+* every other frame — a decoration ``placed`` did not judge beside a drawing of the shape, a body nothing draws (the ``drawn``
   check's), a capsule or mesh — is unknown: pixels where either picture shows one are left out, since
   what it hides cannot be told;
 * faces fainter than :data:`conformance.apps.picture.FAINT` show nothing of their frame;
@@ -49,25 +50,39 @@ UNKNOWN = -2
 ROUNDED_SLACK = 2
 
 
-def _statuses(judgement) -> tuple[set[int], set[int]]:
-    """The frames judged in pictures, and the background ones (static bases); all others are unknown."""
+def _statuses(judgement) -> tuple[set[int], set[int], set[int]]:
+    """The frames judged in pictures, the background ones (static bases), and the judged frames that
+    nothing draws as their collision shape; all others are unknown."""
     r = judgement.r
     background = {i for i, f in enumerate(r.frames) if f.mass == 0 and f.link == -1}
     judged, refused = set(), set()
     for _track, _a, frame, _rows, result in judgement.placements():
         (judged if result.judged else refused).add(frame)
     kinds = {i for i, f in enumerate(r.frames) if len(f.shapes) == 1 and f.shapes[0][0] in silhouettes.MIN_IOU}
-    return (judged - refused - background) & kinds, background
+    # A body whose every drawing is another shape than its collision shape (FURY 0.12's own chain demo draws
+    # 1 m discs as thin rods) is still held to pyBullet's picture of it: "a picture that is not what the
+    # physics says is wrong". A body with a decoration beside a drawing of its shape stays unknown.
+    unlike = (refused - judged - background) & kinds
+    return ((judged - refused - background) & kinds) | unlike, background, unlike
 
 
-def labels(shot: dict, recording, attachments, judged: set[int], background: set[int]) -> tuple[np.ndarray, np.ndarray]:
+def labels(shot: dict, recording, attachments, judged: set[int], background: set[int],
+           decorations: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """``(fury, bullet)``: each pixel's judged frame index in the two pictures of ``shot``, -1 for none
-    or background, and -1 in both where either shows an unknown frame (left out)."""
-    owner = np.concatenate([a.frame for a in attachments]).astype(np.int64) if attachments else np.zeros(0, np.int64)
+    or background, and -1 in both where either shows an unknown frame or a ``decorations`` vertex (a
+    mask over every actor's vertices, in order; left out)."""
+    # A vertex no frame holds (``attached`` fails it) is unknown: its best guess may be the world, and as
+    # background it would count against every body it hides. So is a decoration pyBullet does not have
+    # (FURY's own demos add actor.axes() at the origin, in front of two bricks of the brick wall).
+    owner = (np.concatenate([np.where(a.held, a.frame, UNKNOWN) for a in attachments]).astype(np.int64)
+             if attachments else np.zeros(0, np.int64))
+    if decorations is not None:
+        owner[decorations] = UNKNOWN
     frames = len(recording.frames)
-    # frame → label: judged frames themselves, background -1, the rest unknown; the world (-1) is background
-    table = np.full(frames + 1, UNKNOWN, dtype=np.int64)
-    table[-1] = -1
+    # frame → label: judged frames themselves, background -1, the rest unknown; the world (-1) is background;
+    # the entry after the world is for vertices held by nothing
+    table = np.full(frames + 2, UNKNOWN, dtype=np.int64)
+    table[frames] = -1
     for f in background:
         table[f] = -1
     for f in judged:
@@ -75,7 +90,7 @@ def labels(shot: dict, recording, attachments, judged: set[int], background: set
     vertices = np.asarray(shot["vertices"], dtype=np.int64)
     seen = vertices >= 0
     fury = np.where(vertices == UNKNOWN, UNKNOWN, -1).astype(np.int64)
-    frame_of = np.where(owner < 0, frames, owner)  # the world at the end of the table
+    frame_of = np.where(owner == UNKNOWN, frames + 1, np.where(owner < 0, frames, owner))
     fury[seen] = table[frame_of[vertices[seen]]]
     faint = np.asarray(shot["faint"], dtype=bool)
     fury[seen & (fury >= 0) & faint[np.where(seen, vertices, 0)]] = -1  # too faint to show its frame
@@ -84,6 +99,19 @@ def labels(shot: dict, recording, attachments, judged: set[int], background: set
     out = (fury == UNKNOWN) | (bullet == UNKNOWN)
     fury[out], bullet[out] = -1, -1
     return fury.astype(np.int32), bullet.astype(np.int32)
+
+
+def _decorations(judgement, unlike: set[int]) -> np.ndarray:
+    """Over every actor's vertices in order: those drawn as something pyBullet does not have, whose pixels
+    are left out — held by the world, or by a frame whose shape ``placed`` refused them as, unless nothing
+    draws that frame's shape (``unlike``: then the drawing is the body's, and is judged)."""
+    starts = np.cumsum([0] + [a.frame.shape[0] for a in judgement.attachments])
+    mask = np.concatenate([a.held & (a.frame < 0) for a in judgement.attachments]) if judgement.attachments else np.zeros(0, bool)
+    for k, (track, a) in enumerate(zip(judgement.r.actors, judgement.attachments)):
+        for placed_track, _a, frame, rows, result in judgement.placements():
+            if placed_track is track and not result.judged and frame not in unlike:
+                mask[starts[k] + rows] = True
+    return mask
 
 
 def rounded_outlines(fury: np.ndarray, bullet: np.ndarray, rounded: set[int], slack: int) -> np.ndarray:
@@ -136,17 +164,18 @@ def check(judgement):
 
     r = judgement.r
     verdict = Verdict("pictured", True)
-    judged, background = _statuses(judgement)
+    judged, background, unlike = _statuses(judgement)
     names = [f.label for f in r.frames]
     limits = [silhouettes.MIN_IOU.get(f.shapes[0][0], 1.0) if len(f.shapes) == 1 else 1.0 for f in r.frames]
     app = Path(r.script).name
     rounded = {i for i in judged if r.frames[i].shapes[0][0] in ("sphere", "cylinder")}
     worst = None
+    decorations = _decorations(judgement, unlike)
     for shot in r.pictures:
         if "skipped" in shot:
             verdict.notes.append(f"no picture at tick {shot['tick']}: {shot['skipped']}")
             continue
-        fury, bullet = labels(shot, r, judgement.attachments, judged, background)
+        fury, bullet = labels(shot, r, judgement.attachments, judged, background, decorations)
         outline = rounded_outlines(fury, bullet, rounded, ROUNDED_SLACK)
         fury[outline], bullet[outline] = -1, -1
         touching = {tuple(p) for p in shot.get("touching", [])}
@@ -170,7 +199,7 @@ def check(judgement):
         for t in sorted(failing, key=lambda t: t["iou"] - t["min_iou"]):
             verdict.passed = False
             union = _union(t)
-            diagnosis = _diagnosis(t["index"], shot, r, judgement.attachments)
+            diagnosis = _diagnosis(t["index"], shot, r, judgement.attachments) or ("not-its-shape" if t["index"] in unlike else "")
             verdict.lines.append(
                 f"{app}, tick {shot['tick']}: {t['target']} is not where pyBullet's renderer draws it from the app's camera: "
                 f"{round((1 - t['iou']) * union)} pixels off beyond the {record.details['slack']} px edge slack, "

@@ -26,6 +26,10 @@ def add_arguments(parser) -> None:
                         "pictures and their records (default: the scene checks' results directory, conformance-results)")
 
 
+#: Notes printed under each check.
+NOTES = 3
+
+
 def _print_result(result, label: str, results=None) -> None:
     r = result.recording
     steps = sorted(set(int(s) for s in r.steps[1:])) or [0]
@@ -37,6 +41,11 @@ def _print_result(result, label: str, results=None) -> None:
             print(f"      {line}")
         if len(verdict.lines) > 12:
             print(f"      … {len(verdict.lines) - 12} more lines")
+        # What the check could not decide, or left out, is part of its verdict (a pass that judged nothing says so).
+        for note in dict.fromkeys(verdict.notes[:NOTES]):
+            print(f"      note: {note}")
+        if len(verdict.notes) > NOTES:
+            print(f"      … {len(verdict.notes) - NOTES} more notes")
         if check == "pictured" and results is not None and not verdict.passed:  # nothing written for a pass
             from conformance.apps import pictured
 
