@@ -63,5 +63,5 @@ def test_each_example_reports_how_close_it_came_to_failing(monkeypatch):
         assert label == VERTEX_TARGET
         return value
 
-    assert closest("reference") < 0.01
-    assert 0.05 < closest("wrong_syncs:Float32Incremental") < 1.0  # drifting, not yet failing
+    # FURY 2 stores every vertex in float32: the reference uses 1.5 % of the tolerance there (0 on FURY 0.12)
+    assert closest("reference") < 0.03 < closest("wrong_syncs:Float32Incremental") < 1.0  # drifting, not yet failing
