@@ -96,17 +96,22 @@ def command(spec: str, *, stop_at_first: bool = False, survey: bool = False, pyt
             *(["--conformance-survey"] if survey else []), *(["-x"] if stop_at_first else []), *pytest_args]
 
 
-def check(spec: str, *, stop_at_first: bool = False, survey: bool = False, pytest_args=(), env=None) -> Outcome:
+def check(spec: str, *, stop_at_first: bool = False, survey: bool = False, pytest_args=(), env=None,
+          timeout: float | None = None) -> Outcome:
     """Run the sync checks on ``spec`` in a pytest process of its own and read its report. The run's
-    pictures go to a temporary directory of its own, so runs side by side never share one."""
+    pictures go to a temporary directory of its own, so runs side by side never share one. A run still
+    going after ``timeout`` seconds is stopped: no records, and its stderr says so."""
     with tempfile.TemporaryDirectory() as tmp:
         report = os.path.join(tmp, "report.json")
         argv = command(spec, stop_at_first=stop_at_first, survey=survey, pytest_args=list(pytest_args), report=report,
                        results=os.path.join(tmp, "results"))
         from conformance.display import child_environment, dies_with_this_process
 
-        proc = subprocess.run(argv, capture_output=True, text=True, env=child_environment(env),
-                              preexec_fn=dies_with_this_process(waited_for=True))  # none outlives a killed command
+        try:
+            proc = subprocess.run(argv, capture_output=True, text=True, env=child_environment(env), timeout=timeout,
+                                  preexec_fn=dies_with_this_process(waited_for=True))  # none outlives a killed command
+        except subprocess.TimeoutExpired:
+            return Outcome(spec, -9, [], f"the run did not complete within {timeout:g} s and was stopped")
         if not os.path.exists(report):
             return Outcome(spec, proc.returncode, [], (proc.stderr or proc.stdout)[-1500:])
         with open(report, encoding="utf-8") as fh:
