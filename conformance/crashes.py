@@ -34,14 +34,16 @@ import os
 import shutil
 import signal
 import tempfile
+import threading
+import time
 from pathlib import Path
 
 import pytest
 
 from conformance.errors import SyncCrashed
 
-__all__ = ["CHOICES", "Controller", "Journal", "allow_restarts", "arrange", "at", "check_not_crashed", "noting",
-           "start_journal"]
+__all__ = ["CHOICES", "Controller", "Journal", "Watchdog", "allow_restarts", "arrange", "at", "check_not_crashed",
+           "hard_limit", "noting", "returned", "start_journal"]
 
 CHOICES = ("auto", "process", "none")
 _INPUT_KEY = "conformance_crash_dir"
@@ -87,9 +89,11 @@ class Journal:
         self._stack = open(directory / f"{worker}.stack", "w")  # noqa: SIM115 - open for the process's life
         faulthandler.enable(file=self._stack, all_threads=False)
         self.nodeid = ""
+        self.where: dict = {}
 
     def note(self, **where) -> None:
-        data = json.dumps({"nodeid": self.nodeid, **where}).encode("utf-8")[:_RECORD_SIZE - 1]
+        self.where = where
+        data = json.dumps({"nodeid": self.nodeid, "pid": os.getpid(), **where}).encode("utf-8")[:_RECORD_SIZE - 1]
         os.pwrite(self._fd, data.ljust(_RECORD_SIZE, b" "), 0)
 
     def crashed(self, spec: str, scene: str) -> dict | None:
@@ -113,9 +117,16 @@ def noting(nodeid: str) -> None:
 
 
 def at(scene: str, step: int | None) -> None:
-    """The sync is about to be called on ``scene`` at ``step`` (``None``: its factory)."""
+    """The sync is about to be called on ``scene`` at ``step`` (``None``: its factory); the controller's
+    watchdog (:class:`Watchdog`) times the call from now."""
     if _journal is not None:
-        _journal.note(scene=scene, step=step)
+        _journal.note(scene=scene, step=step, since=time.time())
+
+
+def returned() -> None:
+    """The call into the sync returned (or raised): the watchdog stops timing it; where it was stays noted."""
+    if _journal is not None and _journal.where.get("since") is not None:
+        _journal.note(**{**_journal.where, "since": None})
 
 
 def check_not_crashed(spec: str, scene: str) -> None:
@@ -138,10 +149,12 @@ class Controller:
     """The pytest-xdist controller's side: a crash directory for the workers, and a crashed worker's
     check turned into the kit's failure paragraph and record."""
 
-    def __init__(self, config, sync_spec: str, record_property: str):
+    def __init__(self, config, sync_spec: str, record_property: str, sync_limit: float | None = None):
         self.config, self.sync_spec, self.record_property = config, sync_spec, record_property
         self.directory = Path(tempfile.mkdtemp(prefix="conformance-crashes-"))
         (self.directory / "crashed").mkdir()
+        limit = hard_limit(sync_limit)
+        self.watchdog = Watchdog(self.directory, limit) if limit else None
 
     def pytest_configure_node(self, node) -> None:
         node.workerinput[_INPUT_KEY] = str(self.directory)
@@ -163,6 +176,11 @@ class Controller:
         worker = report.node.gateway.id
         where = self._read_where(worker, crashitem)
         how = _how_it_died(report.node)
+        hung = self.directory / f"{worker}.hung"
+        if hung.exists():
+            how = (f"stopped by the kit after {_read(hung).strip()} s in one call: the per-call time limit could not "
+                   "interrupt it, so it is looping in C code, where Python's alarm is never delivered")
+            hung.unlink()
         stack = _read(self.directory / f"{worker}.stack")
         scene, step = where.get("scene"), where.get("step")
         if scene is not None:
@@ -209,7 +227,58 @@ class Controller:
         return where if where.get("nodeid") == crashitem else {}
 
     def pytest_unconfigure(self, config) -> None:
+        if self.watchdog is not None:
+            self.watchdog.stop()
         shutil.rmtree(self.directory, ignore_errors=True)
+
+
+def hard_limit(sync_limit: float | None) -> float | None:
+    """Seconds after which the controller stops a worker stuck in one sync call: twice the per-call limit
+    and 5 s more (the alarm repeats every second, so a call Python can interrupt has long given way);
+    None when calls have no limit."""
+    from conformance import time_limit
+
+    limit = time_limit.DEFAULT if sync_limit is None else sync_limit
+    return 2 * limit + 5 if limit else None
+
+
+class Watchdog:
+    """The controller's thread that stops a worker stuck in one call into the sync past ``limit`` seconds.
+
+    The per-call limit is ``SIGALRM``, which Python delivers only between bytecodes: a sync looping in C
+    (``list(map(f, itertools.repeat(x)))``, a machine-made mutant of the reference) never returns, holds
+    the GIL, and grew by 130 MB a second until the machine ran out of memory (24 GB). The worker notes when
+    each call starts and returns (:class:`Journal`); this thread, in another process, reads the notes once
+    a second and sends ``SIGABRT`` to a worker past the limit, whose faulthandler writes the stack; the
+    crash then becomes the check's failure like any other, saying why it was stopped."""
+
+    def __init__(self, directory: Path, limit: float):
+        self.directory, self.limit = directory, limit
+        self._stopped = threading.Event()
+        self._thread = threading.Thread(target=self._watch, name="conformance-watchdog", daemon=True)
+        self._thread.start()
+
+    def stop(self) -> None:
+        self._stopped.set()
+
+    def _watch(self) -> None:
+        while not self._stopped.wait(1.0):
+            for path in self.directory.glob("*.where"):
+                try:
+                    where = json.loads(_read(path).strip() or "{}")
+                except ValueError:
+                    continue
+                since, pid = where.get("since"), where.get("pid")
+                if since is None or pid is None or time.time() - since <= self.limit:
+                    continue
+                hung = path.with_suffix(".hung")
+                if hung.exists():
+                    continue
+                hung.write_text(f"{time.time() - since:.0f}")
+                try:
+                    os.kill(pid, signal.SIGABRT)
+                except ProcessLookupError:
+                    hung.unlink()
 
 
 def _crash_file(directory: Path, spec: str, scene: str) -> Path:

@@ -240,8 +240,9 @@ def _watch_for_crashes(config: pytest.Config) -> None:
 
     crashes.allow_restarts(config, len(scenes.names()))
     spec = _sync_spec(config)
-    config.pluginmanager.register(crashes.Controller(config, spec, _RECORD_PROPERTY), "conformance-crashes")
-    _option(config, "sync_timeout"), tolerance_from(config)  # a bad value: the usage error, here, once
+    seconds = _option(config, "sync_timeout")  # a bad value: the usage error, here, once
+    tolerance_from(config)
+    config.pluginmanager.register(crashes.Controller(config, spec, _RECORD_PROPERTY, seconds), "conformance-crashes")
     from conformance.sync import SHORT_NAMES
 
     if spec not in SHORT_NAMES:

@@ -102,6 +102,8 @@ class SyncImplementation:
                 f"sync implementation {self.spec!r} raised while being set up for scene {world.scene!r}: "
                 f"{_exception_line(exc)}{_user_location(exc)}."
             ) from exc
+        finally:
+            crashes.returned()
         if not callable(step_fn):
             raise SyncProtocolError(
                 f"sync implementation {self.spec!r} returned {step_fn!r} (type {type(step_fn).__name__}) for scene "
@@ -139,6 +141,8 @@ class Syncer:
                 f"sync implementation {self.spec!r} raised on scene {self.scene!r} at step {frame}: "
                 f"{_exception_line(exc)}{_user_location(exc)}."
             ) from exc
+        finally:
+            crashes.returned()
 
 
 def _check_arity(fn: Any, n: int, what: str) -> None:

@@ -96,6 +96,16 @@ def test_an_abort_or_an_exit_is_a_verdict_too(run, sync, how):
     assert _outcomes(records)["test_vertices_match_poses_every_frame[sliding_box]"] == "passed", text
 
 
+def test_a_loop_in_c_that_the_alarm_cannot_stop_is_stopped_by_the_watchdog(run):
+    """A call looping inside C never sees the per-call alarm; the controller stops its worker at twice the
+    limit and 5 s more (here 1 s: 7 s), and the check fails saying so, where it was, and the run goes on."""
+    result, records, text = run("crashing_syncs:LoopsInCOnFreeFall", "--conformance-sync-timeout", "1")
+    assert result.ret == pytest.ExitCode.TESTS_FAILED, text
+    assert "stopped by the kit after" in text and "looping in C code" in text, text
+    assert f"scene '{SCENE}' at step {CALL - 1}" in text and "crashing_syncs.py" in text, text
+    assert _outcomes(records)["test_vertices_match_poses_every_frame[sliding_box]"] == "passed", text
+
+
 def test_a_right_sync_of_the_users_is_isolated_and_passes(run):
     result, records, text = run("conformance.implementations.reference:ReferenceSync")
     assert result.ret == pytest.ExitCode.OK, text
