@@ -20,6 +20,12 @@ CHECKS = (f"(test_vertices_match_poses_every_frame or test_sync_keeps_the_mesh o
 SUBSET = ["--pyargs", "conformance", "-p", "no:cacheprovider", "--hypothesis-profile", "default", "-k", CHECKS]
 
 
+def _ours(cmdline: bytes) -> bool:
+    """Whether a process is one of the kit's: Python, or a pytest-xdist worker, which retitles itself
+    ("[pytest-xdist running] …") when setproctitle is installed (mutmut brings it)."""
+    return b"python" in cmdline or cmdline.startswith(b"[pytest-xdist")
+
+
 def _xvfb() -> set[int]:
     """Xvfb servers alive whose parent is gone: left behind. A zombie has died already (whoever inherits
     it reaps it); a server whose parent lives is someone else's, e.g. one of the kit's own background runs
@@ -28,7 +34,7 @@ def _xvfb() -> set[int]:
     orphans = set()
     for pid, stat, parent in (row.split() for row in rows.splitlines() if row.strip()):
         if not stat.startswith("Z") and (parent == "1" or not Path(f"/proc/{parent}/cmdline").exists()
-                                         or b"python" not in Path(f"/proc/{parent}/cmdline").read_bytes()):
+                                         or not _ours(Path(f"/proc/{parent}/cmdline").read_bytes())):
             orphans.add(int(pid))
     return orphans
 
