@@ -15,10 +15,10 @@ Which frames are judged, and what the others are:
 * a frame whose drawing ``placed`` judged (its vertices span its one box, sphere or cylinder) is
   judged, by its kind's threshold; so is a frame of one such shape whose every drawing ``placed``
   refused as another shape (nothing draws what pyBullet simulates: diagnosis ``not-its-shape``);
-* the world and static bodies (mass 0) are background in both pictures: an app may draw them as part
-  of the world (a ground plate, a static decoration) or not at all, as the vertex checks allow; where
-  such a thing is drawn in front of a body it hides it in both pictures alike, or, if it has no body in
-  pyBullet, counts against that body (the picture does not show it);
+* static bodies (mass 0) are background in both pictures: an app may draw them (a ground plate) or not
+  at all, as the vertex checks allow; a drawing pyBullet does not have (held by the world, or a
+  decoration ``placed`` refused) and a vertex no frame holds are left out, since what they hide cannot
+  be told;
 * every other frame — a decoration ``placed`` did not judge beside a drawing of the shape, a body nothing draws (the ``drawn``
   check's), a capsule or mesh — is unknown: pixels where either picture shows one are left out, since
   what it hides cannot be told;
@@ -105,12 +105,13 @@ def _decorations(judgement, unlike: set[int]) -> np.ndarray:
     """Over every actor's vertices in order: those drawn as something pyBullet does not have, whose pixels
     are left out — held by the world, or by a frame whose shape ``placed`` refused them as, unless nothing
     draws that frame's shape (``unlike``: then the drawing is the body's, and is judged)."""
-    starts = np.cumsum([0] + [a.frame.shape[0] for a in judgement.attachments])
-    mask = np.concatenate([a.held & (a.frame < 0) for a in judgement.attachments]) if judgement.attachments else np.zeros(0, bool)
-    for k, (track, a) in enumerate(zip(judgement.r.actors, judgement.attachments)):
-        for placed_track, _a, frame, rows, result in judgement.placements():
-            if placed_track is track and not result.judged and frame not in unlike:
-                mask[starts[k] + rows] = True
+    if not judgement.attachments:
+        return np.zeros(0, bool)
+    starts = dict(zip(map(id, judgement.attachments), np.cumsum([0] + [a.frame.shape[0] for a in judgement.attachments])))
+    mask = np.concatenate([a.held & (a.frame < 0) for a in judgement.attachments])
+    for _track, a, frame, rows, result in judgement.placements():
+        if not result.judged and frame not in unlike:
+            mask[starts[id(a)] + rows] = True
     return mask
 
 
