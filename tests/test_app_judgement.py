@@ -147,6 +147,22 @@ def test_normals_that_do_not_turn_fail_the_normals_check():
     assert _failing(verdicts) == {"normals"} and verdicts["normals"].diagnoses == ["stale-normals"]
 
 
+def test_the_normals_worst_figure_counts_only_vertices_a_frame_holds():
+    """A vertex no frame holds fails ``attached``; its normal has no frame to turn with, so it is not in
+    ``normals``' worst figure (FURY 0.12's brick wall printed a pass at 117 times the allowance)."""
+    pos, orn = motion()
+    rng = np.random.default_rng(1)
+    stray = rng.normal(size=(len(pos), 1, 3))  # a vertex wandering with no body, its normal spinning
+    normals = CORNERS / np.linalg.norm(CORNERS, axis=1, keepdims=True)
+    right = np.einsum("tij,nj->tni", Rotation.from_quat(orn).as_matrix(), normals)
+    spinning = stray / np.linalg.norm(stray, axis=2, keepdims=True)
+    vertices = np.concatenate([draw(pos, orn), stray], axis=1)
+    verdicts = judge(recording([box_frame()], [(pos, orn)],
+                               [track(vertices, normals=np.concatenate([right, spinning], axis=1))]))
+    assert _failing(verdicts) >= {"attached"} and "normals" not in _failing(verdicts)
+    assert verdicts["normals"].worst <= 1.0, verdicts["normals"].worst
+
+
 def test_a_static_decoration_and_a_static_body_are_not_required_to_move():
     pos, orn = motion()
     still = (np.tile([[0.0, 0.0, -0.1]], (len(pos), 1)), np.tile([[0, 0, 0, 1.0]], (len(pos), 1)))

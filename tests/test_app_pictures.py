@@ -72,6 +72,27 @@ def test_a_body_drawn_two_pixels_off_fails():
     assert not verdict.passed, "a 2 px shift is beyond the 1 px slack, as for the scene checks"
 
 
+def test_a_sliver_is_left_out_and_a_body_seen_whole_is_not():
+    """A body showing only an edge in both pictures (a disc's rim behind another) is left out with a note:
+    which renderer covers those pixels is its tessellation's business (:func:`pictured.edges_only`)."""
+    from conformance.apps import pictured
+
+    fury, bullet = np.zeros(SIZE[::-1], bool), np.zeros(SIZE[::-1], bool)
+    fury[10, 2:62], bullet[14, 2:62] = True, True  # 60 pixels each, 4 px apart: IoU 0 as judged
+    verdict = _judged([_shot(_labels(fury, 0), _labels(bullet, 0))])
+    assert verdict.passed and "showed only an edge" in " ".join(verdict.notes), verdict.message()
+    assert pictured.edges_only(_labels(fury, 0), _labels(bullet, 0)).sum() == 120
+    whole = _square(top=12, side=10) | bullet  # drawn whole in one picture: judged, and off
+    assert not _judged([_shot(_labels(fury, 0), _labels(whole, 0))]).passed
+
+
+def test_only_the_first_failing_picture_is_told_body_by_body():
+    missing = _shot(np.full(SIZE[::-1], -1), _labels(_square(), 0))
+    verdict = _judged([missing, {**missing, "tick": 80}])
+    assert len(verdict.lines) == 2 and "tick 40: body 0 base" in verdict.lines[0], verdict.lines
+    assert verdict.lines[1].startswith("hand-made.py, tick 80: as well, 1 body not where pyBullet's renderer draws it")
+
+
 def test_a_faint_or_hidden_actor_is_diagnosed_hidden():
     faint = _judged([_shot(_labels(_square(), 0), _labels(_square(), 0), faint=np.ones(8, bool))])
     assert not faint.passed and faint.diagnoses == ["hidden"]
@@ -216,12 +237,36 @@ def test_a_ball_outline_a_pixel_wider_is_the_tessellation_slack_but_four_are_not
 PICTURE_ONLY = {"vtk": "brick_wall_fades_in.py", "pygfx": "brick_wall_fades_in.py"}
 
 
+#: Per FURY, the line that hides the small box app's actor from its 20th tick to its 40th, then shows it.
+HIDE_FOR_A_WHILE = {"vtk": "    ball_actor.SetVisibility(not 20 <= cnt < 40)\n", "pygfx": "    box.visible = not 20 <= cnt < 40\n"}
+
+
+def test_an_actor_hidden_for_a_while_is_seen_in_a_picture_during_the_run(tmp_path):
+    """The pictures are taken at several ticks of a run (:func:`conformance.apps.picture.picture_ticks`),
+    not only at its end: the box app ends at its 51st tick, shown, and was hidden at the kit's tick 30.
+    (Its box is made five times larger: at its own size it covers under 50 pixels, too few to judge.)"""
+    from conformance.apps import picture
+
+    app = Path(__file__).parent / "apps" / f"box_{backends.NAME}.py"
+    step = "    p.stepSimulation()\n"
+    script = tmp_path / "app.py"
+    source = app.read_text(encoding="utf-8").replace("[[0.2, 0.4, 0.2]]", "[[1.0, 2.0, 1.0]]").replace("[0.1, 0.2, 0.1]", "[0.5, 1.0, 0.5]")
+    script.write_text(source.replace(step, step + HIDE_FOR_A_WHILE[backends.NAME]), encoding="utf-8")
+    result = apps.check_app(script, ticks=120)
+    assert [shot["tick"] for shot in result.recording.pictures] == [30, 51]
+    failing = {c for c, v in result.verdicts.items() if not v.passed}
+    assert failing == {"pictured"}, {c: result.verdicts[c].message()[:500] for c in failing}
+    verdict = result.verdicts["pictured"]
+    assert verdict.diagnoses == ["hidden"] and "tick 30: body 0 base" in verdict.lines[0], verdict.message()
+    assert picture.picture_ticks(120, pictures=1) == [120]  # with one picture, at the end, it would pass
+
+
 @pytest.mark.parametrize("ticks", [90])
 def test_only_the_picture_check_sees_the_example_mistake(ticks, tmp_path):
     """On the installed FURY, a real app (the example) fails ``pictured`` with its diagnosis and passes
     every other check: a mistake no other app check catches; its pictures are written as the scene
     checks' are."""
-    from conformance.apps import pictured
+    from conformance.apps import picture, pictured
 
     script = Path(__file__).resolve().parent.parent / "examples" / backends.NAME / "wrong" / PICTURE_ONLY[backends.NAME]
     result = apps.check_app(script, ticks=ticks)
@@ -229,7 +274,7 @@ def test_only_the_picture_check_sees_the_example_mistake(ticks, tmp_path):
     assert failing == {"pictured"}, {c: result.verdicts[c].message()[:500] for c in failing}
     verdict = result.verdicts["pictured"]
     assert verdict.diagnoses and set(verdict.diagnoses) == {"hidden"}
-    assert f"tick {ticks}: body " in verdict.lines[0]
+    assert f"tick {picture.picture_ticks(ticks)[0]}: body " in verdict.lines[0]
     written = pictured.keep(verdict, tmp_path, result.reproduce())
     assert {Path(w).name.rsplit("-", 1)[-1] for w in written} == {"fury_mask.png", "pybullet_mask.png", "mask_difference.png"}
     assert all((tmp_path / w).stat().st_size for w in written)

@@ -11,6 +11,7 @@ command in ``docs/apps.md``; this is its fixed sample.
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import pytest
@@ -24,8 +25,9 @@ TICKS = 40
 
 @pytest.fixture
 def wrapped(monkeypatch):
-    def run(scene: str, sync: str, **kwargs):
+    def run(scene: str, sync: str, params: dict | None = None, **kwargs):
         monkeypatch.setenv("KIT_SCENE", scene)
+        monkeypatch.setenv("KIT_PARAMS", json.dumps(params or {}))
         monkeypatch.setenv("KIT_SYNC", sync)
         monkeypatch.setenv("KIT_STEPS", str(TICKS))
         monkeypatch.setenv("PYTHONPATH", str(Path(__file__).parent))  # the child imports tests' sync modules
@@ -57,10 +59,26 @@ def test_right_syncs_wrapped_as_apps_pass(wrapped, scene, sync):
     ("crossing", "wrong_syncs:SkipsLastTarget", "drawn", None),
     ("weighted", "wrong_syncs:WritesPoseBack", "untouched", "written-back"),
     ("wrecking_ball", "wrong_syncs:WrongVertexRange", "placed", "other-body"),
+    # shared sphere actors (the scene's default draws each body by its own actor, whose normals VTK and
+    # pygfx turn with its matrix)
+    ("mixed_shapes:by_kind", "wrong_syncs:NormalsNotRotated", "normals", "stale-normals"),
 ])
 def test_wrong_syncs_wrapped_as_apps_fail_with_their_diagnosis(wrapped, scene, sync, check, diagnosis):
-    result = wrapped(scene, sync)
+    scene, _, grouping = scene.partition(":")
+    result = wrapped(scene, sync, {"grouping": grouping} if grouping else None)
     verdict = result.verdicts[check]
     assert not verdict.passed, f"{sync} on {scene}: {check} passed"
     if diagnosis is not None:
         assert diagnosis in verdict.diagnoses, verdict.message()
+
+
+def test_a_sync_gated_on_velocity_fails_the_perturbed_opening(wrapped):
+    """``VelocityGated`` skips bodies whose velocity is exactly zero. After a step under gravity no
+    falling body's is, so the app's own run passes; the opening's teleport between the step and the sync
+    of tick 4 leaves one at rest, drawn where it was (:class:`conformance.apps.perturb.AfterStep`). Without
+    that teleport, ``free_fall``'s opening passes it (measured)."""
+    assert wrapped("free_fall", "wrong_syncs:VelocityGated").passed
+    found = perturbed.search(APP, examples=1)
+    assert found is not None, "the perturbed opening passed VelocityGated"
+    assert not found.verdicts["attached"].passed, found.verdicts["attached"].message()
+    assert any(e.get("after_step") for e in found.events)

@@ -124,10 +124,13 @@ class Driver:
         self._steps = 0
         self._tick = 0
         self._reading = 0.0  # seconds of the kit's reads inside the app's ticks (before each step)
-        self._picturing = 0.0  # seconds of the pictures at the end of the run
+        self._picturing = 0.0  # seconds of the pictures (conformance.apps.picture.picture_ticks)
         self._stepped = False  # this tick has called stepSimulation
         self._written = None   # (positions, orientations, velocities) just before the first write since the last step
         self._writers: set[str] = set()
+        self._kit_writing = False  # the kit's own after-step events are not the app's writes
+        self._after_step_due = False  # this tick's AfterStep events are still to apply
+        self._events_client = 0  # the client the kit's events go to: the app's first
 
     # -- what the patches call ------------------------------------------------------------------
     def offer(self, source) -> None:
@@ -157,7 +160,7 @@ class Driver:
     def before_write(self, name: str) -> None:
         """The app is about to write to pyBullet's state: after this tick's last step that is the sync's part
         of the tick, which should only read. The state before the first such write is kept to compare."""
-        if self._frames and self._stepped:
+        if self._frames and self._stepped and not self._kit_writing:
             if self._written is None:
                 start = time.perf_counter()
                 pos, orn = bodies.read_poses(self._frames)
@@ -173,6 +176,18 @@ class Driver:
             self._before = bodies.read_poses(self._frames)
             self._steps += 1
             self._reading += time.perf_counter() - start
+
+    def after_step(self) -> None:
+        """The tick's first step is done: apply its :class:`~conformance.apps.perturb.AfterStep` events."""
+        if not self._after_step_due:
+            return
+        from conformance.apps import perturb
+
+        self._after_step_due, self._kit_writing = False, True
+        try:
+            perturb.apply_after_step(self.events, self._tick, self._events_client, self._frames)
+        finally:
+            self._kit_writing = False
 
     # -- the loop --------------------------------------------------------------------------------
     def _source(self):
@@ -202,6 +217,7 @@ class Driver:
             raise AppLoopNotFound(f"{self.script}: the app's scene has no actor drawing polygons, so there is nothing "
                                   "to check; add the actors to the scene the ShowManager shows.")
         self._frames = bodies.frames_of(clients)
+        self._events_client = clients[0]
         names = _labels(actors)
         tracks = [_Track(a, names.get(id(a)) or f"actor #{i}", self._backend) for i, a in enumerate(actors)]
         mapped = mapping.resolve(self.script, sys.modules.get("__main__"), actors, names,
@@ -229,27 +245,35 @@ class Driver:
         ended = f"the kit's tick limit ({self.ticks})"
         in_ticks = in_snapshots = 0.0
         from conformance.apps import perturb
+        from conformance.apps.picture import picture_ticks
 
+        pictures = []
+        early = set(picture_ticks(self.ticks)) - {self.ticks}  # the last is taken where the run ends
         try:
             for tick in range(1, self.ticks + 1):
                 self._tick = tick
                 self._stepped, self._written, self._writers = False, None, set()  # the kit's own events are not the app's
                 perturb.apply(self.events, tick, clients[0], self._frames)
+                self._after_step_due = any(isinstance(e, perturb.AfterStep) and e.frame == tick for e in self.events)
                 self._steps = 0
                 self._before = None
                 start = time.perf_counter()
                 source.tick()
+                self._after_step_due = False  # a tick that did not step applies none
                 middle = time.perf_counter()
                 snapshot()
                 in_ticks, in_snapshots = in_ticks + middle - start, in_snapshots + time.perf_counter() - middle
                 steps.append(self._steps)
+                if tick in early:
+                    pictures.append(self._picture(source, tracks, clients, tick))
                 if source.done():
                     ended = f"{source.ended()} after tick {tick}"
                     break
         except Exception as exc:  # the app's own code raised inside its callback: that is a verdict
             self.raised(exc)
             ended = f"the app raised at tick {len(steps)}"
-        pictures = [self._picture(source, tracks, clients, len(steps) - 1)]
+        if not pictures or pictures[-1]["tick"] != len(steps) - 1:
+            pictures.append(self._picture(source, tracks, clients, len(steps) - 1))
         notes = []
         if source.actors() and len(source.actors()) != len(actors):
             notes.append(f"the scene had {len(actors)} actors when the loop started and {len(source.actors())} at its end; "
@@ -265,7 +289,7 @@ class Driver:
                      "picture": self._picturing})
 
     def _picture(self, source, tracks, clients, tick: int) -> dict:
-        """The pictures of the last tick (:mod:`conformance.apps.picture`); a picture that cannot be taken
+        """The pictures of tick ``tick`` (:mod:`conformance.apps.picture`); a picture that cannot be taken
         leaves the other checks' recording whole and says why."""
         from conformance.apps import picture
 
@@ -275,7 +299,7 @@ class Driver:
         except Exception as exc:  # a renderer that cannot draw here must not cost the vertex checks
             return {"tick": tick, "skipped": f"the picture could not be drawn: {type(exc).__name__}: {exc}"}
         finally:
-            self._picturing = time.perf_counter() - start
+            self._picturing += time.perf_counter() - start
 
 
 class _Track:
@@ -360,6 +384,8 @@ def install_pybullet(driver: Driver) -> None:
 
     def step_(*args, **kwargs):
         driver.before_step()
-        return step(*args, **kwargs)
+        result = step(*args, **kwargs)
+        driver.after_step()
+        return result
 
     pybullet.connect, pybullet.disconnect, pybullet.stepSimulation = connect_, disconnect_, step_

@@ -11,8 +11,8 @@ Checks (the names are the pytest ids and the ``app`` command's lines):
 * ``announced``: every change of an actor's vertex data was announced to the renderer at the tick it was made;
 * ``untouched``: after a tick's last ``stepSimulation`` — where the sync runs — the app leaves every body's pose
   and velocity as pyBullet computed them (a sync only reads the simulation; the guide's recipes only read);
-* ``pictured``: the app's picture at the end of the run, from its own camera, shows each body where pyBullet's
-  own renderer shows it (:mod:`conformance.apps.pictured`).
+* ``pictured``: the app's pictures at four ticks of the run (the last at its end), from its own camera, show
+  each body where pyBullet's own renderer shows it (:mod:`conformance.apps.pictured`).
 
 Everything is computed from the :class:`~conformance.apps.recording.Recording` alone.
 """

@@ -8,16 +8,34 @@ sync has to draw poses its story never produces. Events name bodies by position 
 app's *dynamic* bodies (``which`` modulo its length; static bodies are left where the app put them,
 so an app may draw them as part of the world) and joints by position in the list of movable joints,
 and are drawn by Hypothesis (:func:`conformance.strategies.app_events`), so a failure is reproducible from its JSON.
+
+An event wrapped in :class:`AfterStep` is applied instead right after the first ``stepSimulation`` of its
+tick, before the app's sync reads: a body teleported there is at rest when the sync runs
+(``resetBasePositionAndOrientation`` leaves its velocity zero, pybullet-facts.md), which after a step
+under gravity it never is. The scene checks sync right after their events, with no step between; this
+is how an app's sync meets the same state.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from types import SimpleNamespace
 
 from conformance import events as scene_events
 from conformance.apps.bodies import Frame
 
-__all__ = ["apply", "as_dict", "from_dicts"]
+__all__ = ["AfterStep", "apply", "apply_after_step", "as_dict", "from_dicts"]
+
+
+@dataclass(frozen=True)
+class AfterStep:
+    """``event``, applied right after the first step of its tick instead of before the tick."""
+
+    event: object
+
+    @property
+    def frame(self) -> int:
+        return self.event.frame
 
 
 def _scene(client: int, frames: list[Frame], dynamic: bool):
@@ -31,7 +49,15 @@ def _scene(client: int, frames: list[Frame], dynamic: bool):
 
 def apply(events, tick: int, client: int, frames: list[Frame]) -> None:
     """Apply the events of ``tick`` to the app's first client (before the app's callback of that tick)."""
-    due = [e for e in events if e.frame == tick]
+    _apply([e for e in events if e.frame == tick and not isinstance(e, AfterStep)], client, frames)
+
+
+def apply_after_step(events, tick: int, client: int, frames: list[Frame]) -> None:
+    """Apply the :class:`AfterStep` events of ``tick`` (after the first step of that tick)."""
+    _apply([e.event for e in events if e.frame == tick and isinstance(e, AfterStep)], client, frames)
+
+
+def _apply(due, client: int, frames: list[Frame]) -> None:
     if not due:
         return
     for event in due:
@@ -43,10 +69,14 @@ def apply(events, tick: int, client: int, frames: list[Frame]) -> None:
 def as_dict(event) -> dict:
     import json
 
+    if isinstance(event, AfterStep):
+        return {**as_dict(event.event), "after_step": True}
     return json.loads(scene_events.dumps([event]))[0]
 
 
 def from_dicts(items) -> list:
     import json
 
-    return scene_events.loads(json.dumps(list(items)))
+    items = [dict(item) for item in items]
+    flags = [bool(item.pop("after_step", False)) for item in items]
+    return [AfterStep(e) if after else e for e, after in zip(scene_events.loads(json.dumps(items)), flags)]

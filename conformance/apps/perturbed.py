@@ -21,7 +21,9 @@ __all__ = ["opening", "search"]
 
 
 def opening() -> list:
-    """The first perturbed run's events: every way of turning a body the kit has, early in the run."""
+    """The first perturbed run's events: every way of turning a body the kit has, early in the run, and
+    one body turned between the step and the sync of tick 4, so that the sync sees it at rest."""
+    from conformance.apps.perturb import AfterStep
     from conformance.events import JointReset, Kick, Teleport
 
     hard = strategies.HARD_ORIENTATIONS
@@ -29,7 +31,8 @@ def opening() -> list:
     turns = (hard[8], hard[11], hard[17], hard[13])
     return ([Teleport(frame=1, which=i, offset=(0.0, 0.0, 0.0), orientation=q) for i, q in enumerate(turns)]
             + [JointReset(frame=2, which=0, value=1.0, orientation=hard[10]),
-               Kick(frame=3, which=1, velocity=(1.0, -1.0, 2.0), offset=(0.0, 0.0, 0.0), spin=(5.0, -7.0, 3.0))])
+               Kick(frame=3, which=1, velocity=(1.0, -1.0, 2.0), offset=(0.0, 0.0, 0.0), spin=(5.0, -7.0, 3.0)),
+               AfterStep(Teleport(frame=4, which=0, offset=(0.0, 0.0, 0.0), orientation=hard[13]))])
 
 
 class _Found(Exception):

@@ -69,7 +69,8 @@ class Recording:
     writers: list = field(default_factory=list)  # per tick, the names of the writing calls
     #: the app's mapping (:mod:`conformance.apps.mapping`): {"actor", "start", "stop", "frame"} entries
     mapping: list = field(default_factory=list)
-    #: the pictures taken at the end of the run (:func:`conformance.apps.picture.take`): dicts whose
+    #: the pictures taken during the run (:func:`conformance.apps.picture.take`, at
+    #: :func:`~conformance.apps.picture.picture_ticks`): dicts whose
     #: array values are numpy arrays
     pictures: list = field(default_factory=list)
 

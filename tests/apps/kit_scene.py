@@ -2,10 +2,11 @@
 program: build, register a per-frame callback on FURY's ShowManager that steps and syncs, start.
 
 The scene and the sync come from the environment (``KIT_SCENE``, ``KIT_SYNC`` as ``--sync`` takes it,
-``KIT_STEPS``), so one file wraps every pair; ``tests/test_app_wrapped.py`` runs it through app mode to show
+``KIT_STEPS``, and the scene's parameters as JSON in ``KIT_PARAMS``), so one file wraps every pair; ``tests/test_app_wrapped.py`` runs it through app mode to show
 that app mode and the scene checks agree on the kit's own syncs.
 """
 import itertools
+import json
 import os
 
 import fury
@@ -15,10 +16,11 @@ from conformance import runner, sync
 
 SCENE = os.environ["KIT_SCENE"]
 STEPS = int(os.environ.get("KIT_STEPS", "60"))
+PARAMS = json.loads(os.environ.get("KIT_PARAMS", "{}"))
 implementation = sync.load(os.environ.get("KIT_SYNC", "reference"))
 counter = itertools.count(1)
 
-with runner.running(SCENE, implementation) as run:
+with runner.running(SCENE, implementation, **PARAMS) as run:
     scene = window.Scene()
     for drawn in run.drawing.actors.values():
         scene.add(drawn)
