@@ -78,7 +78,9 @@ def what_it_is(spec: str) -> str:
 
     doc = inspect.getdoc(load(spec).factory) or ""
     text = re.sub(r"^(Wrong|Right): ", "", " ".join(doc.split("\n\n")[0].split()))
-    end = re.search(r"(?<!i\.e)(: |\. )", text)
+    # the first ": " or ". " outside parentheses ("static (mass 0: the ground…)" is one clause)
+    end = next((m for m in re.finditer(r"(?<!i\.e)(: |\. )", text)
+                if text[:m.start()].count("(") <= text[:m.start()].count(")")), None)
     return (text[:end.start()] if end else text).replace("|", "/")
 
 

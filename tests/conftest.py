@@ -10,6 +10,7 @@ import conformance.runner  # noqa: F401
 import conformance.test_scenes  # noqa: F401
 import conformance.test_vertices  # noqa: F401
 import PIL.Image  # noqa: F401
+import pytest
 
 pytest_plugins = ["pytester"]
 
@@ -21,8 +22,11 @@ def pytest_collection_modifyitems(items):
     items[:] = [item for item, w in zip(items, waits) if not w] + [item for item, w in zip(items, waits) if w]
 
 
-def pytest_collection_finish(session):
-    """Start the subprocess runs the selected tests will need, all at once (see ``background``)."""
+@pytest.hookimpl(tryfirst=True)
+def pytest_runtestloop(session):
+    """Start the subprocess runs the selected tests will need, all at once (see ``background``); when the
+    tests start, not when collection ends, so that a run refused after collection (a -k typo) starts none
+    and does not wait minutes for them at its end."""
     if hasattr(session.config, "workerinput") or session.config.getoption("collectonly"):
         return
     import background

@@ -80,6 +80,9 @@ def test_what_an_implementation_is_comes_from_its_docstring():
     assert verdicts.what_it_is("wrong_syncs:VelocityGated") == (
         'after the first frame, skips bodies whose velocity is exactly zero ("a body at rest has not moved")')
     assert verdicts.what_it_is("right_syncs:UserMatrixSync").startswith("per-actor ")  # user matrices or local.matrix
+    # a colon inside parentheses does not end the clause
+    assert verdicts.what_it_is("order_syncs:StaticSetAtFrameZero").startswith(
+        "decides once, at start-up, which bodies are static (mass 0: the ground, walls, a fixed base) and, ")
 
 
 def test_tables_replace_only_their_block_of_the_readme(tmp_path):
