@@ -261,6 +261,26 @@ def test_an_actor_hidden_for_a_while_is_seen_in_a_picture_during_the_run(tmp_pat
     assert picture.picture_ticks(120, pictures=1) == [120]  # with one picture, at the end, it would pass
 
 
+#: Per FURY, the line that hides the two-client app's second box (pyBullet client 1) from its 20th tick on.
+HIDE_SECOND = {"vtk": "    pairs[1][2].SetVisibility(cnt < 20)\n", "pygfx": "    pairs[1][2].visible = cnt < 20\n"}
+
+
+def test_bodies_of_every_client_are_in_pyBullets_picture(tmp_path):
+    """Each pyBullet client is a world of its own, which an app may draw in one scene: pyBullet's picture
+    is every client's, put together by its depth buffer. (With the first client's only, this right app's
+    second box was "not where pyBullet draws it".)"""
+    app = Path(__file__).parent / "apps" / f"two_clients_{backends.NAME}.py"
+    result = apps.check_app(app, ticks=60)
+    assert result.passed, {c: v.message()[:500] for c, v in result.verdicts.items() if not v.passed}
+    judged = [{t["target"] for t in record.details["targets"]} for record, _ in result.verdicts["pictured"].pictures]
+    assert all(targets == {"body 0 base (link0)", "client 1 body 0 base (link0)"} for targets in judged), judged
+    script = tmp_path / "app.py"
+    step = "    showm.render()\n"
+    script.write_text(app.read_text(encoding="utf-8").replace(step, HIDE_SECOND[backends.NAME] + step), encoding="utf-8")
+    hidden = apps.check_app(script, ticks=60).verdicts["pictured"]
+    assert not hidden.passed and "client 1 body 0 base" in hidden.lines[0] and hidden.diagnoses == ["hidden"], hidden.message()
+
+
 @pytest.mark.parametrize("ticks", [90])
 def test_only_the_picture_check_sees_the_example_mistake(ticks, tmp_path):
     """On the installed FURY, a real app (the example) fails ``pictured`` with its diagnosis and passes

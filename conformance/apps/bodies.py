@@ -49,8 +49,10 @@ class Frame:
 
     @property
     def label(self) -> str:
+        """``body 3 link 1 (name)``; on a client other than 0, ``client 1 body 3 …`` (body ids restart on every client)."""
         where = "base" if self.link == -1 else f"link {self.link}"
-        return f"body {self.body} {where}" + (f" ({self.name})" if self.name else "")
+        client = f"client {self.client} " if self.client else ""
+        return f"{client}body {self.body} {where}" + (f" ({self.name})" if self.name else "")
 
 
 def _text(value) -> str:

@@ -4,7 +4,8 @@ At :data:`PICTURES` ticks of every run, evenly spaced, the last at its end (the 
 perturbed one, :func:`picture_ticks`), the kit draws the app's own actors, as
 its own ShowManager holds them, from the app's own camera (:mod:`conformance.apps.picture_vtk`,
 :mod:`conformance.apps.picture_pygfx`), each face flat in a colour that codes it, and pyBullet's tiny
-renderer draws its segmentation mask on the app's client from the same camera
+renderer draws its segmentation mask on each of the app's clients from the same camera, put together by
+its depth buffer
 (:func:`conformance.rendering.silhouettes.pybullet_mask`, the scene checks' own). Which body a face
 draws is not known here: the judgement (:mod:`conformance.apps.pictured`) labels each face by the frame
 the attachment gives its first vertex. So the picture keeps, per pixel, the app-wide index of that
@@ -136,17 +137,23 @@ def take(source, tracks, frames, clients, tick: int) -> dict:
     points = np.concatenate([t.vertices[-1] for t in tracks]) if tracks else np.zeros((0, 3))
     camera = replace(camera, clipping_range=clipping_range(camera, points))
     drawn = source.faces([t.actor for t in tracks], camera, size, [t.gpu for t in tracks])
-    client = clients[0]
-    own = [i for i, f in enumerate(frames) if f.client == client]
-    bound = [SimpleNamespace(body=frames[i].body, link=frames[i].link) for i in own]
-    seen = silhouettes.pybullet_mask(SimpleNamespace(p=BoundClient(client)), bound, camera, size)
-    bullet = np.where(seen >= 0, np.asarray(own + [-1], dtype=np.int32)[seen], -1).astype(np.int32)
-    notes = list(drawn.get("notes", []))
-    if len(set(clients)) > 1:
-        notes.append(f"pyBullet drew client {client} only: bodies of the app's other clients are not in its picture")
+    # Each client is a world of its own, which the app draws in one scene: pyBullet draws each from the
+    # same camera, and the nearest drawing at each pixel (its depth buffer) is what the scene shows.
+    bullet = np.full(size[::-1], -1, dtype=np.int32)
+    nearest = np.full(size[::-1], np.inf)
+    pairs = []
+    for client in dict.fromkeys(clients):
+        own = [i for i, f in enumerate(frames) if f.client == client]
+        bound = [SimpleNamespace(body=frames[i].body, link=frames[i].link) for i in own]
+        seen, depth = silhouettes.pybullet_mask(SimpleNamespace(p=BoundClient(client)), bound, camera, size, depth=True)
+        depth = np.where(seen >= 0, depth, np.inf)
+        front = depth < nearest
+        bullet[front] = np.asarray(own + [-1], dtype=np.int32)[seen[front]]
+        nearest[front] = depth[front]
+        pairs += touching(client, frames)
     return {"tick": tick, "size": list(size), "camera": camera.as_dict(), "vertices": drawn["vertices"],
             "bullet": bullet, "faint": drawn["faint"], "stale": drawn["stale"], "hidden": drawn["hidden"],
-            "touching": touching(client, frames), "notes": notes}
+            "touching": pairs, "notes": list(drawn.get("notes", []))}
 
 
 def view_angle(vertical: float | None = None, *, horizontal: float | None = None, aspect: float = 1.0) -> float:

@@ -209,8 +209,9 @@ def check(judgement):
         rims = edges_only(fury, bullet)
         if rims.any():
             shown = np.concatenate([fury[rims], bullet[rims]])
-            verdict.notes.append(f"tick {shot['tick']}: {len(np.unique(shown[shown >= 0]))} bodies showed only an edge in both "
-                                 "pictures (a sliver, which each renderer's tessellation decides): left out")
+            slivers = len(np.unique(shown[shown >= 0]))
+            verdict.notes.append(f"tick {shot['tick']}: {slivers} {'bodies' if slivers > 1 else 'body'} showed only an edge in "
+                                 "both pictures (a sliver, which each renderer's tessellation decides): left out")
             fury[rims], bullet[rims] = -1, -1
         touching = {tuple(p) for p in shot.get("touching", [])}
         record = silhouettes.compare_silhouettes(fury, bullet, min_iou=limits, names=names, scene=f"app-{Path(r.script).stem}",

@@ -60,9 +60,11 @@ HALF_PIXEL = True
 SLACK = 1
 
 
-def pybullet_mask(scene, bindings: Sequence, camera, size) -> np.ndarray:
+def pybullet_mask(scene, bindings: Sequence, camera, size, *, depth: bool = False):
     """``(height, width)`` int32: the index into ``bindings`` of the (body, link) pyBullet's tiny
-    renderer sees at each pixel, -1 for the background or a body no binding names; top row first."""
+    renderer sees at each pixel, -1 for the background or a body no binding names; top row first. With
+    ``depth``, also the renderer's depth buffer (``(height, width)``, 1 where nothing is drawn), to put
+    the pictures of several clients together."""
     width, height = size
     view = projection.view_matrix(camera).T.ravel().tolist()
     matrix = projection.projection_matrix(camera, size)
@@ -77,6 +79,8 @@ def pybullet_mask(scene, bindings: Sequence, camera, size) -> np.ndarray:
     out = np.full(seg.shape, -1, dtype=np.int32)
     for i, b in enumerate(bindings):
         out[seg == b.body + ((b.link + 1) << 24)] = i
+    if depth:
+        return out, np.asarray(image[3], dtype=np.float64).reshape(height, width)
     return out
 
 
