@@ -131,6 +131,27 @@ def test_step_that_raises_names_the_step(pytester):
                                   "sync_h.py:")
 
 
+def test_a_sync_on_the_default_client_fails_and_is_told_to_use_world_p(pytester):
+    """The checks' scenes are never on pyBullet's default client 0 (a decoy holds it): a sync whose
+    pybullet calls leave out the scene's client (the mutant ``a4f27042dd`` of the reference's fast path,
+    docs/mutants-vtk.md) read an empty world and fail, told what to do, where on client 0 they drew the
+    right poses by luck."""
+    _write(pytester, "sync_client", """
+        import pybullet
+        from conformance.implementations.reference import ReferenceSync
+
+        class Sync(ReferenceSync):
+            def __call__(self):
+                for t in self.targets:
+                    pybullet.getBasePositionAndOrientation(t.body)  # no physicsClientId: client 0
+                super().__call__()
+    """)
+    result = pytester.runpytest(*RUN, "--sync", "sync_client:Sync")
+    _assert_one_paragraph_failure(result, "raised", "GetBasePositionAndOrientation failed",
+                                  "client 0, the default of every pybullet call made without physicsClientId",
+                                  "p = world.p")
+
+
 def test_sync_writing_nan_fails_with_non_finite_message(pytester):
     _write(pytester, "sync_i", """
         import numpy as np
