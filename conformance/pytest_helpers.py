@@ -85,7 +85,7 @@ def _label(scene: str, params: Mapping[str, Any]) -> str:
 
 #: Said under a sync's error when a decoy client holds pyBullet's default id (:func:`decoy_client`).
 NOT_THE_DEFAULT_CLIENT = (
-    "The scene is on pyBullet client {client}; client 0, the default of every pybullet call made without "
+    "The scene is not on pyBullet's client 0: client 0, the default of every pybullet call made without "
     "physicsClientId, is an empty world here. Read the simulation through world.p (pybullet bound to the "
     "scene's client: p = world.p) or pass physicsClientId=world.client (README, \"The sync protocol\").")
 
@@ -114,16 +114,14 @@ def sync_run(scene: str, implementation, events: Sequence = (), **params: Any) -
     from conformance import runner
 
     with decoy_client() as decoy:
-        client = None
         try:
             with runner.running(scene, implementation, events=events, **params) as run:
-                client = run.scene.client
                 yield run
         except SyncError as err:  # the paragraph alone: the kit's frames and the error's chain say nothing more
             text = str(err)
             # pybullet raises its own class, named ``error``, when a call names a body the client has not
             if decoy is not None and ": error: " in text:
-                text += " " + NOT_THE_DEFAULT_CLIENT.format(client=client if client is not None else "1")
+                text += " " + NOT_THE_DEFAULT_CLIENT
             raise pytest.fail.Exception(text, pytrace=False) from None
 
 

@@ -253,7 +253,7 @@ class Driver:
             for tick in range(1, self.ticks + 1):
                 self._tick = tick
                 self._stepped, self._written, self._writers = False, None, set()  # the kit's own events are not the app's
-                perturb.apply(self.events, tick, clients[0], self._frames)
+                perturb.apply(self.events, tick, self._events_client, self._frames)
                 self._after_step_due = any(isinstance(e, perturb.AfterStep) and e.frame == tick for e in self.events)
                 self._steps = 0
                 self._before = None
