@@ -8,11 +8,19 @@ out a :class:`BoundClient`: it forwards attribute access to :mod:`pybullet` and 
 
 from __future__ import annotations
 
+import contextlib
 import functools
+from typing import Iterator
 
 import pybullet
 
-__all__ = ["BoundClient"]
+__all__ = ["NOT_THE_DEFAULT_CLIENT", "BoundClient", "decoy_client"]
+
+#: Said under a sync's pybullet error when the scene is not on pyBullet's default id (:func:`decoy_client`).
+NOT_THE_DEFAULT_CLIENT = (
+    "The scene is not on pyBullet's client 0: client 0, the default of every pybullet call made without "
+    "physicsClientId, is another world here. Read the simulation through world.p (pybullet bound to the "
+    "scene's client: p = world.p) or pass physicsClientId=world.client (README, \"The sync protocol\").")
 
 
 class BoundClient:
@@ -34,3 +42,18 @@ class BoundClient:
 
     def __repr__(self) -> str:
         return f"BoundClient(client={self._client})"
+
+
+@contextlib.contextmanager
+def decoy_client() -> Iterator[int | None]:
+    """Hold pyBullet's default client id 0 with an empty world while a scene is built and run, so that the
+    scene is on another client: a sync that calls pybullet without the scene's client reads nothing there
+    and fails, where on client 0 it would draw the right poses by luck (the mutant ``a4f27042dd``,
+    docs/discrimination.md). Yields 0 when it holds it, None when 0 was taken already (pyBullet gives a
+    new connection the lowest free id, so a scene built inside is not on 0 then either)."""
+    decoy = pybullet.connect(pybullet.DIRECT)
+    try:
+        yield decoy if decoy == 0 else None
+    finally:
+        if decoy >= 0:
+            pybullet.disconnect(physicsClientId=decoy)

@@ -83,46 +83,17 @@ def _label(scene: str, params: Mapping[str, Any]) -> str:
     return f"{scene}({inner})"
 
 
-#: Said under a sync's error when a decoy client holds pyBullet's default id (:func:`decoy_client`).
-NOT_THE_DEFAULT_CLIENT = (
-    "The scene is not on pyBullet's client 0: client 0, the default of every pybullet call made without "
-    "physicsClientId, is an empty world here. Read the simulation through world.p (pybullet bound to the "
-    "scene's client: p = world.p) or pass physicsClientId=world.client (README, \"The sync protocol\").")
-
-
-@contextlib.contextmanager
-def decoy_client() -> Iterator[int | None]:
-    """Hold pyBullet's default client id 0 with an empty world while a check's scene is built and run, so
-    that the scene is on another client: a sync that calls pybullet without the scene's client reads
-    nothing there and fails, where on client 0 it would draw the right poses by luck. (pyBullet gives a
-    new connection the lowest free id; when 0 is taken already, the scene is not on it anyway.)"""
-    import pybullet
-
-    decoy = pybullet.connect(pybullet.DIRECT)
-    try:
-        yield decoy if decoy == 0 else None
-    finally:
-        if decoy >= 0:
-            pybullet.disconnect(physicsClientId=decoy)
-
-
 @contextlib.contextmanager
 def sync_run(scene: str, implementation, events: Sequence = (), **params: Any) -> Iterator[Any]:
-    """``runner.running`` for a check, on a scene that is not on pyBullet's default client
-    (:func:`decoy_client`): a sync implementation that raises fails the check with one clear paragraph
-    instead of a traceback through the kit."""
+    """``runner.running`` for a check: a sync implementation that raises fails the check with one clear
+    paragraph instead of a traceback through the kit."""
     from conformance import runner
 
-    with decoy_client() as decoy:
-        try:
-            with runner.running(scene, implementation, events=events, **params) as run:
-                yield run
-        except SyncError as err:  # the paragraph alone: the kit's frames and the error's chain say nothing more
-            text = str(err)
-            # pybullet raises its own class, named ``error``, when a call names a body the client has not
-            if decoy is not None and ": error: " in text:
-                text += " " + NOT_THE_DEFAULT_CLIENT
-            raise pytest.fail.Exception(text, pytrace=False) from None
+    try:
+        with runner.running(scene, implementation, events=events, **params) as run:
+            yield run
+    except SyncError as err:  # the paragraph alone: the kit's frames and the error's chain say nothing more
+        raise pytest.fail.Exception(str(err), pytrace=False) from None
 
 
 def _context(run: Any, sync: str, frame: int) -> str:

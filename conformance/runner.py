@@ -14,6 +14,8 @@ from typing import Any, Iterator, Mapping, Sequence
 
 from conformance import backends, truth
 from conformance.backends.common import Drawing
+from conformance.client import NOT_THE_DEFAULT_CLIENT, decoy_client
+from conformance.errors import SyncRaised
 from conformance.events import Event
 from conformance.scenes import Scene, build
 from conformance.sync import Syncer, SyncImplementation
@@ -113,11 +115,22 @@ class Run:
 @contextlib.contextmanager
 def running(scene: str, implementation: SyncImplementation, events: Sequence[Event] = (), **params: Any) -> Iterator[Run]:
     """Build ``scene`` with ``params``, draw it, start the sync, apply frame-0 events and sync frame 0;
-    always disconnect."""
-    with build(scene, **params) as built:
-        drawing = backends.build(built)
-        syncer = implementation.start(drawing.world)
-        run = Run(scene=built, drawing=drawing, syncer=syncer, params=dict(built.params), events=tuple(events))
-        run.apply_events()
-        run.sync()
-        yield run
+    always disconnect. The scene is never on pyBullet's default client 0 (an empty decoy holds it,
+    :func:`conformance.client.decoy_client`), so a sync that leaves out the scene's client fails here as
+    in a user's program with more than one client, and its error says so."""
+    client = -1
+    with decoy_client():
+        try:
+            with build(scene, **params) as built:
+                client = built.client
+                drawing = backends.build(built)
+                syncer = implementation.start(drawing.world)
+                run = Run(scene=built, drawing=drawing, syncer=syncer, params=dict(built.params), events=tuple(events))
+                run.apply_events()
+                run.sync()
+                yield run
+        except SyncRaised as err:
+            # pybullet raises its own class, named ``error``, when a call names a body its client has not
+            if client == 0 or ": error: " not in str(err):
+                raise
+            raise SyncRaised(f"{err} {NOT_THE_DEFAULT_CLIENT}") from err.__cause__

@@ -82,3 +82,5 @@ def test_a_sync_gated_on_velocity_fails_the_perturbed_opening(wrapped):
     assert found is not None, "the perturbed opening passed VelocityGated"
     assert not found.verdicts["attached"].passed, found.verdicts["attached"].message()
     assert any(e.get("after_step") for e in found.events)
+    # drawn where it was before the step only at the teleport's tick, right at every other: skipped, not late
+    assert found.verdicts["attached"].diagnoses == ["skipped"], found.verdicts["attached"].message()

@@ -131,3 +131,26 @@ def test_bad_input_is_one_paragraph_and_exit_2_before_anything_runs(capsys, args
     status, out, err = compare(capsys, *args)
     assert status == 2
     assert out == "" and err.startswith(message) and err.count("\n") == 1, err
+
+
+class ReadsClientZero(ReferenceSync):
+    """Right, but it also reads every body's pose from pybullet without the scene's client (client 0)."""
+
+    def __call__(self):
+        import pybullet
+
+        for t in self.targets:
+            pybullet.getBasePositionAndOrientation(t.body)
+        super().__call__()
+
+
+def test_a_sync_reading_client_zero_does_not_agree_on_either_side(capsys):
+    """``compare`` runs its scenes off pyBullet's default client as the checks do (``runner.running``
+    holds client 0 with a decoy), on side A and on side B, so it never calls a sync right that
+    the checks reject, and its paragraph says to use ``world.p``."""
+    for args in (("test_compare_command:ReadsClientZero", "reference"), ("reference", "test_compare_command:ReadsClientZero")):
+        status, out, _ = compare(capsys, *args, "free_fall", "--frames", "3")
+        assert status == 1, out
+        assert "GetBasePositionAndOrientation failed" in out
+        assert "client 0, the default of every pybullet call made without physicsClientId" in out
+        assert "p = world.p" in out

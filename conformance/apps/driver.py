@@ -129,8 +129,7 @@ class Driver:
         self._written = None   # (positions, orientations, velocities) just before the first write since the last step
         self._writers: set[str] = set()
         self._kit_writing = False  # the kit's own after-step events are not the app's writes
-        self._after_step_due = False  # this tick's AfterStep events are still to apply
-        self._events_client = 0  # the client the kit's events go to: the app's first
+        self._after_step_due: set[int] = set()  # the clients whose first step of this tick is still to come
 
     # -- what the patches call ------------------------------------------------------------------
     def offer(self, source) -> None:
@@ -177,15 +176,17 @@ class Driver:
             self._steps += 1
             self._reading += time.perf_counter() - start
 
-    def after_step(self) -> None:
-        """The tick's first step is done: apply its :class:`~conformance.apps.perturb.AfterStep` events."""
-        if not self._after_step_due:
+    def after_step(self, client: int) -> None:
+        """``client``'s first step of the tick is done: apply the tick's
+        :class:`~conformance.apps.perturb.AfterStep` events to its bodies."""
+        if client not in self._after_step_due:
             return
         from conformance.apps import perturb
 
-        self._after_step_due, self._kit_writing = False, True
+        self._after_step_due.discard(client)
+        self._kit_writing = True
         try:
-            perturb.apply_after_step(self.events, self._tick, self._events_client, self._frames)
+            perturb.apply_after_step(self.events, self._tick, client, self._frames)
         finally:
             self._kit_writing = False
 
@@ -217,7 +218,6 @@ class Driver:
             raise AppLoopNotFound(f"{self.script}: the app's scene has no actor drawing polygons, so there is nothing "
                                   "to check; add the actors to the scene the ShowManager shows.")
         self._frames = bodies.frames_of(clients)
-        self._events_client = clients[0]
         names = _labels(actors)
         tracks = [_Track(a, names.get(id(a)) or f"actor #{i}", self._backend) for i, a in enumerate(actors)]
         mapped = mapping.resolve(self.script, sys.modules.get("__main__"), actors, names,
@@ -253,13 +253,14 @@ class Driver:
             for tick in range(1, self.ticks + 1):
                 self._tick = tick
                 self._stepped, self._written, self._writers = False, None, set()  # the kit's own events are not the app's
-                perturb.apply(self.events, tick, self._events_client, self._frames)
-                self._after_step_due = any(isinstance(e, perturb.AfterStep) and e.frame == tick for e in self.events)
+                perturb.apply(self.events, tick, self._frames)
+                if any(isinstance(e, perturb.AfterStep) and e.frame == tick for e in self.events):
+                    self._after_step_due = {f.client for f in self._frames}
                 self._steps = 0
                 self._before = None
                 start = time.perf_counter()
                 source.tick()
-                self._after_step_due = False  # a tick that did not step applies none
+                self._after_step_due = set()  # a client that did not step this tick gets none
                 middle = time.perf_counter()
                 snapshot()
                 in_ticks, in_snapshots = in_ticks + middle - start, in_snapshots + time.perf_counter() - middle
@@ -385,7 +386,7 @@ def install_pybullet(driver: Driver) -> None:
     def step_(*args, **kwargs):
         driver.before_step()
         result = step(*args, **kwargs)
-        driver.after_step()
+        driver.after_step(kwargs.get("physicsClientId", args[0] if args else 0))
         return result
 
     pybullet.connect, pybullet.disconnect, pybullet.stepSimulation = connect_, disconnect_, step_

@@ -56,6 +56,10 @@ DIAGNOSES = {name: text for name, (text, _) in attach_mod.VARIANTS.items()} | {
     "not-its-shape": "nothing draws the shape pyBullet simulates for this body: every drawing it holds is another "
                      "shape (another size, or turned) than its collision shape, and the picture differs from "
                      "pyBullet's own: build the actor from the collision shape's dimensions and orientation",
+    "skipped": "drawn where it was before the tick's step at some ticks only: at other ticks where pyBullet moved it "
+               "it is drawn right, so the sync is not late but skips the body on some condition (zero velocity, "
+               "a sleeping flag, a pose it takes as unchanged, every other call): draw every body whenever the "
+               "sync is called (README, \"The sync protocol\")",
     "stale-gpu": "the GPU still holds older vertices of this body: the vertices were written but the range announced "
                  "with positions.update_range(offset, count) does not cover them (offset and count are in vertices); "
                  "announce every range written, or update_full()",
@@ -282,6 +286,11 @@ class _Judgement:
             positions, rotations = make(self.pos[:, f], self.orn[:, f], before_pos, before_orn)
             if attach_mod.variant_fit(vertices, np.asarray(positions), np.asarray(rotations), reference,
                                       allowance, bad_ticks):
+                # A late sync is late wherever the body moved; drawn right at some of those ticks, it skipped
+                if name == "previous-step" and not attach_mod.variant_fit(
+                        vertices, np.asarray(positions), np.asarray(rotations), reference, allowance,
+                        np.arange(len(vertices))):
+                    return "skipped"
                 return name
         return ""
 

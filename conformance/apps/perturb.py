@@ -4,8 +4,9 @@ An app's bodies move only as its story goes: a wall that tips about one axis nev
 angles applied in the wrong order turn a body about the wrong axes. Because the kit drives the app's
 loop, it can do to the app what it does to its scenes (:mod:`conformance.events`): before the app's
 callback of tick ``k``, turn a body to a hard orientation, kick it, or reset a joint, so that the app's
-sync has to draw poses its story never produces. Events name bodies by position in the list of the
-app's *dynamic* bodies (``which`` modulo its length; static bodies are left where the app put them,
+sync has to draw poses its story never produces. Every event is applied on every pyBullet client of the
+app that has bodies (an app may keep an empty client, or one per world). Events name bodies by position
+in the list of a client's *dynamic* bodies (``which`` modulo its length; static bodies are left where the app put them,
 so an app may draw them as part of the world) and joints by position in the list of movable joints,
 and are drawn by Hypothesis (:func:`conformance.strategies.app_events`), so a failure is reproducible from its JSON.
 
@@ -47,13 +48,15 @@ def _scene(client: int, frames: list[Frame], dynamic: bool):
     return SimpleNamespace(p=p, bindings=[SimpleNamespace(body=b) for b in wanted], dt=dt)
 
 
-def apply(events, tick: int, client: int, frames: list[Frame]) -> None:
-    """Apply the events of ``tick`` to the app's first client (before the app's callback of that tick)."""
-    _apply([e for e in events if e.frame == tick and not isinstance(e, AfterStep)], client, frames)
+def apply(events, tick: int, frames: list[Frame]) -> None:
+    """Apply the events of ``tick`` on every client of ``frames`` (before the app's callback of that tick)."""
+    due = [e for e in events if e.frame == tick and not isinstance(e, AfterStep)]
+    for client in sorted({f.client for f in frames}):
+        _apply(due, client, frames)
 
 
 def apply_after_step(events, tick: int, client: int, frames: list[Frame]) -> None:
-    """Apply the :class:`AfterStep` events of ``tick`` (after the first step of that tick)."""
+    """Apply the :class:`AfterStep` events of ``tick`` on ``client`` (after its first step of that tick)."""
     _apply([e.event for e in events if e.frame == tick and isinstance(e, AfterStep)], client, frames)
 
 
