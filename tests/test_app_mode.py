@@ -36,6 +36,16 @@ def test_a_right_app_passes_every_check_and_its_perturbed_runs():
     assert "verdict: PASS" in done.stdout and "PASS perturbed" in done.stdout
 
 
+def test_an_app_drawing_its_box_longer_than_its_body_fails_only_the_picture(tmp_path):
+    """Every vertex follows the body rigidly, so the vertex checks pass; the box is drawn 0.6 m long
+    where pyBullet simulates 0.4 m, which only the picture against pyBullet's own shows."""
+    longer = SOURCE.replace("scales=np.array([[0.2, 0.4, 0.2]])", "scales=np.array([[0.2, 0.6, 0.2]])")
+    assert longer != SOURCE
+    result = apps.check_app(_copy(tmp_path, longer), ticks=51)
+    assert [name for name, v in result.verdicts.items() if not v.passed] == ["pictured"], result.verdicts
+    assert "not-its-shape" in result.verdicts["pictured"].diagnoses, result.verdicts["pictured"].message()
+
+
 def test_an_app_that_syncs_before_it_steps_is_one_step_late(tmp_path):
     late = SOURCE.replace(STEP, "").replace("    showm.render()\n", "    showm.render()\n" + STEP)
     assert late != SOURCE

@@ -17,6 +17,11 @@ p.resetBaseVelocity(body, [0.5, 0, 0], [1, 2, 3])
 scene = window.Scene()
 scene.add(box)
 showm = window.ShowManager(scene=scene, size=(300, 300))
+# close enough that the box covers a few thousand pixels, so app mode's picture check judges it
+camera = showm.screens[0].camera
+camera.local.position = (0.05, -3, 1.9)
+camera.world.reference_up = (0, 0, 1)
+camera.look_at((0.05, 0, 1.9))
 counter = itertools.count()
 
 def timer_callback():
