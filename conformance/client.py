@@ -45,15 +45,15 @@ class BoundClient:
 
 
 @contextlib.contextmanager
-def decoy_client() -> Iterator[int | None]:
+def decoy_client() -> Iterator[None]:
     """Hold pyBullet's default client id 0 with an empty world while a scene is built and run, so that the
     scene is on another client: a sync that calls pybullet without the scene's client reads nothing there
     and fails, where on client 0 it would draw the right poses by luck (the mutant ``a4f27042dd``,
-    docs/discrimination.md). Yields 0 when it holds it, None when 0 was taken already (pyBullet gives a
-    new connection the lowest free id, so a scene built inside is not on 0 then either)."""
+    docs/discrimination.md). When 0 is taken already, the decoy gets another id and a scene built inside
+    is not on 0 either (pyBullet gives a new connection the lowest free id)."""
     decoy = pybullet.connect(pybullet.DIRECT)
     try:
-        yield decoy if decoy == 0 else None
+        yield
     finally:
         if decoy >= 0:
             pybullet.disconnect(physicsClientId=decoy)

@@ -283,13 +283,11 @@ class _Judgement:
         before_pos = self.r.before_positions[1:][:, f]
         before_orn = self.r.before_orientations[1:][:, f]
         for name, (_, make) in attach_mod.VARIANTS.items():
-            positions, rotations = make(self.pos[:, f], self.orn[:, f], before_pos, before_orn)
-            if attach_mod.variant_fit(vertices, np.asarray(positions), np.asarray(rotations), reference,
-                                      allowance, bad_ticks):
+            positions, rotations = (np.asarray(a) for a in make(self.pos[:, f], self.orn[:, f], before_pos, before_orn))
+            if attach_mod.variant_fit(vertices, positions, rotations, reference, allowance, bad_ticks):
                 # A late sync is late wherever the body moved; drawn right at some of those ticks, it skipped
                 if name == "previous-step" and not attach_mod.variant_fit(
-                        vertices, np.asarray(positions), np.asarray(rotations), reference, allowance,
-                        np.arange(len(vertices))):
+                        vertices, positions, rotations, reference, allowance, np.arange(len(vertices))):
                     return "skipped"
                 return name
         return ""
