@@ -11,15 +11,15 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 from conformance import apps, backends
 from conformance.apps.judge import judge as judge_recording
 
 import app_recordings as rec
+import app_sources
 
-APP = Path(__file__).parent / "apps" / f"box_{backends.NAME}.py"
+APP = app_sources.BOX
 ACTOR, BODY = ("ball_actor", "ball") if backends.NAME == "vtk" else ("box", "body")
 
 
@@ -80,6 +80,18 @@ def test_an_app_is_judged_with_the_mapping_beside_it(tmp_path):
     result = apps.check_app(app, ticks=10)
     assert result.recording.mapping == [{"actor": 0, "start": 0, "stop": result.recording.actors[0].vertices.shape[1],
                                          "frame": 0}]
+    assert all(v.passed for v in result.verdicts.values()), result.verdicts
+
+
+def test_a_mapping_without_a_client_names_the_first_client_with_bodies(tmp_path):
+    """The app keeps an empty client 0 and simulates on client 1: ``Draws`` without ``client`` is its box
+    there, not a body 'on client 0 that does not exist'."""
+    app = _copy(tmp_path, "from conformance.apps.mapping import Draws\n\n"
+                          f"def mapping(app):\n    return [Draws(app.{ACTOR}, app.{BODY})]\n")
+    app.write_text(app_sources.on_a_client_of_its_own(), encoding="utf-8")
+    result = apps.check_app(app, ticks=10)
+    assert [(f.client, f.body) for f in result.recording.frames] == [(1, 0)]
+    assert [m["frame"] for m in result.recording.mapping] == [0]
     assert all(v.passed for v in result.verdicts.values()), result.verdicts
 
 

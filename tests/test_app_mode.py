@@ -9,13 +9,15 @@ import sys
 import textwrap
 from pathlib import Path
 
+import pybullet
 import pytest
 
 from conformance import apps, backends
-from conformance.apps import launch
+from conformance.apps import driver, launch
 
-APP = Path(__file__).parent / "apps" / f"box_{backends.NAME}.py"
-SOURCE = APP.read_text(encoding="utf-8")
+import app_sources
+
+APP, SOURCE = app_sources.BOX, app_sources.SOURCE
 STEP = "    p.stepSimulation()\n"
 
 
@@ -44,6 +46,50 @@ def test_an_app_drawing_its_box_longer_than_its_body_fails_only_the_picture(tmp_
     result = apps.check_app(_copy(tmp_path, longer), ticks=51)
     assert [name for name, v in result.verdicts.items() if not v.passed] == ["pictured"], result.verdicts
     assert "not-its-shape" in result.verdicts["pictured"].diagnoses, result.verdicts["pictured"].message()
+
+
+def test_an_app_on_a_client_of_its_own_through_bullet_client_runs_as_it_would_alone(tmp_path):
+    """BulletClient binds its client id only to what ``inspect.isbuiltin`` calls a builtin; the kit's
+    wrapped ``stepSimulation`` must pass for one, or the app steps the empty client 0 and its box
+    hangs in the air under the kit while it falls without it."""
+    result = apps.check_app(_copy(tmp_path, app_sources.on_a_client_of_its_own()), ticks=20)
+    recording = result.recording
+    assert [(f.client, f.body, f.link) for f in recording.frames] == [(1, 0, -1)]
+    assert list(recording.steps[1:]) == [1] * 20
+    fallen = recording.positions[0, 0, 2] - recording.positions[-1, 0, 2]
+    assert fallen > 0.02, f"the box fell {fallen:.4f} m in 20 ticks under the kit, but should fall as it does alone"
+    assert all(v.passed for v in result.verdicts.values()), {k: v.message() for k, v in result.verdicts.items() if not v.passed}
+
+
+def test_an_app_that_opens_pybullets_window_is_run_without_a_display(tmp_path, monkeypatch):
+    """``p.connect(p.GUI)`` (the Quickstart's first line) needs an X display: FURY 0.12's app process has
+    the kit's Xvfb, so pyBullet's window opens there and the program runs unchanged; FURY 2's has none,
+    and pyBullet would end the process ("cannot connect to X server"), so the kit connects it with
+    ``p.DIRECT`` and says so under ``runs``."""
+    monkeypatch.delenv("DISPLAY", raising=False)
+    windowed = SOURCE.replace("p.connect(p.DIRECT)", "p.connect(p.GUI)")
+    assert windowed != SOURCE
+    result = apps.check_app(_copy(tmp_path, windowed), ticks=10)
+    assert all(v.passed for v in result.verdicts.values()), {k: v.message() for k, v in result.verdicts.items() if not v.passed}
+    notes = result.verdicts["runs"].notes
+    if backends.NAME == "vtk":
+        assert notes == [], notes
+    else:
+        assert len(notes) == 1 and notes[0].startswith("client 0: the app connects with p.GUI") and "p.DIRECT" in notes[0], notes
+
+
+@pytest.mark.parametrize("args, kwargs, display, passed_on", [
+    ((pybullet.GUI,), {}, None, ((pybullet.DIRECT,), {})),
+    ((), {"method": pybullet.GUI, "options": "--width=64"}, None, ((pybullet.DIRECT,), {"options": "--width=64"})),
+    ((pybullet.GUI_SERVER,), {}, None, ((pybullet.DIRECT,), {})),
+    ((pybullet.GUI,), {}, ":0", ((pybullet.GUI,), {})),
+    ((pybullet.DIRECT,), {}, None, ((pybullet.DIRECT,), {})),
+    ((pybullet.SHARED_MEMORY,), {"key": 7}, None, ((pybullet.SHARED_MEMORY,), {"key": 7})),
+])
+def test_only_a_window_with_no_display_is_connected_headless(args, kwargs, display, passed_on):
+    new_args, new_kwargs, note = driver.headless(args, kwargs, display)
+    assert (new_args, new_kwargs) == passed_on
+    assert bool(note) == (passed_on != (args, kwargs))
 
 
 def test_an_app_that_syncs_before_it_steps_is_one_step_late(tmp_path):

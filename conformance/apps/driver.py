@@ -1,14 +1,17 @@
 """Running an app's own loop under the kit, in the app's process (:mod:`conformance.apps.child`).
 
-The kit patches three things before the app's script runs, and nothing in the script:
+The kit patches these things before the app's script runs, and nothing in the script:
 
 * ``pybullet.connect``/``disconnect`` to learn the app's clients (and to run the loop before an app
-  that ends with ``p.disconnect()`` takes its bodies away);
+  that ends with ``p.disconnect()`` takes its bodies away); a ``p.GUI`` connection with no X display
+  to open pyBullet's window on is made with ``p.DIRECT`` (:func:`headless`);
 * ``pybullet.stepSimulation`` to count the steps of each tick and to read every frame just before
   each step (so that a drawing one step behind is recognised as such);
 * pyBullet's state writers (``resetBasePositionAndOrientation``, ``resetBaseVelocity``, ``resetJointState``…)
   to notice the app writing to the simulation after a tick's last step — where the sync runs — and to
   read every frame just before that first write, so the judgement can tell what it changed;
+* ``inspect.isbuiltin``, to say yes for those wrappers as for the functions they stand in for, which is
+  what ``pybullet_utils.bullet_client.BulletClient`` asks before it binds its client id to a call;
 * FURY's window loop (:mod:`conformance.apps.takeover_vtk`, :mod:`conformance.apps.takeover_pygfx`):
   the call that would wait for a person (``showm.start()``, ``window.show``, ``window.record``…)
   drives the app's own per-frame callbacks ``ticks`` times instead, recording after each tick.
@@ -19,6 +22,9 @@ as it does to its scenes: that is what makes the judgement property-based on an 
 
 from __future__ import annotations
 
+import functools
+import inspect
+import os
 import sys
 import time
 import traceback
@@ -114,6 +120,7 @@ class Driver:
         self.tick_function = _TickFunction(tick_function) if tick_function else None
         self.sources: list = []
         self.clients: list[int] = []
+        self.notes: list[str] = []  # what the kit changed or left out, for the recording
         self.finished = False
         self.recording: Recording | None = None
         self.error: str | None = None
@@ -275,7 +282,7 @@ class Driver:
             ended = f"the app raised at tick {len(steps)}"
         if not pictures or pictures[-1]["tick"] != len(steps) - 1:
             pictures.append(self._picture(source, tracks, clients, len(steps) - 1))
-        notes = []
+        notes = list(self.notes)
         if source.actors() and len(source.actors()) != len(actors):
             notes.append(f"the scene had {len(actors)} actors when the loop started and {len(source.actors())} at its end; "
                          "actors added later are not judged")
@@ -364,7 +371,15 @@ def install_pybullet(driver: Driver) -> None:
     (in the app's process)."""
     connect, disconnect, step = pybullet.connect, pybullet.disconnect, pybullet.stepSimulation
 
+    def standing_in_for(builtin):
+        def decorate(wrapper):
+            wrapper = functools.wraps(builtin)(wrapper)
+            wrapper.__conformance_stands_in__ = True
+            return wrapper
+        return decorate
+
     def writer(name, write):
+        @standing_in_for(write)
         def write_(*args, **kwargs):
             driver.before_write(name)
             return write(*args, **kwargs)
@@ -374,15 +389,21 @@ def install_pybullet(driver: Driver) -> None:
         if hasattr(pybullet, name):
             setattr(pybullet, name, writer(name, getattr(pybullet, name)))
 
+    @standing_in_for(connect)
     def connect_(*args, **kwargs):
+        args, kwargs, note = headless(args, kwargs, os.environ.get("DISPLAY"))
         client = connect(*args, **kwargs)
         driver.connected(client)
+        if note and client >= 0:
+            driver.notes.append(f"client {client}: {note}")
         return client
 
+    @standing_in_for(disconnect)
     def disconnect_(*args, **kwargs):
         driver.before_disconnect(kwargs.get("physicsClientId", args[0] if args else 0))
         return disconnect(*args, **kwargs)
 
+    @standing_in_for(step)
     def step_(*args, **kwargs):
         driver.before_step()
         result = step(*args, **kwargs)
@@ -390,3 +411,40 @@ def install_pybullet(driver: Driver) -> None:
         return result
 
     pybullet.connect, pybullet.disconnect, pybullet.stepSimulation = connect_, disconnect_, step_
+    _wrappers_pass_for_builtins()
+
+
+#: pyBullet's connection methods that open its own window (pybullet Quickstart, "connect")
+WINDOWED = tuple(getattr(pybullet, name) for name in ("GUI", "GUI_SERVER", "GUI_MAIN_THREAD") if hasattr(pybullet, name))
+
+
+def headless(args: tuple, kwargs: dict, display: str | None) -> tuple[tuple, dict, str]:
+    """``connect``'s arguments as the kit passes them on, and a note when it changed them. ``p.GUI`` opens
+    pyBullet's own window, which needs an X display on Linux; where there is none (FURY 2 renders
+    without one) pyBullet would end the process with "cannot connect to X server". Such a connection is
+    made with ``p.DIRECT``: the same physics, without the window, which is no part of what the kit checks."""
+    method = args[0] if args else kwargs.get("method")
+    if display or method not in WINDOWED or not sys.platform.startswith("linux"):
+        return args, kwargs, ""
+    options = kwargs.get("options", "")
+    note = ("the app connects with p.GUI, pyBullet's own window, and there is no X display here: the kit ran "
+            "it with p.DIRECT, the same physics without that window (debug sliders then read nothing: "
+            "readUserDebugParameter raises)")
+    return (pybullet.DIRECT,), ({"options": options} if options else {}), note
+
+
+def _wrappers_pass_for_builtins() -> None:
+    """pybullet_utils' ``BulletClient`` (and the copies of it other packages carry) binds its client to a
+    pybullet function only when ``inspect.isbuiltin`` says it is one; the kit's wrappers are Python
+    functions, so without this an app's ``client.stepSimulation()`` would step client 0 instead of its
+    own, and the kit would judge a different program (``tests/test_app_mode.py``)."""
+    if getattr(inspect.isbuiltin, "__conformance_stands_in__", False):
+        return
+    isbuiltin = inspect.isbuiltin
+
+    @functools.wraps(isbuiltin)
+    def isbuiltin_(obj):
+        return isbuiltin(obj) or getattr(obj, "__conformance_stands_in__", False) is True
+
+    isbuiltin_.__conformance_stands_in__ = True
+    inspect.isbuiltin = isbuiltin_

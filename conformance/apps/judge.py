@@ -136,7 +136,8 @@ class _Judgement:
             lines.append("the app's loop ran no tick")
         elif not self.r.steps[1:].any():
             lines.append(f"the app never called p.stepSimulation() in {self.r.ticks} ticks")
-        return Verdict("runs", not lines, lines)
+        # What the kit changed in the app's run, or left out of it, is said under the check that ran it.
+        return Verdict("runs", not lines, lines, notes=list(self.r.notes))
 
     def attached(self) -> Verdict:
         self._attached_done = True

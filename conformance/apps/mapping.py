@@ -41,7 +41,8 @@ class MappingError(ConformanceError):
 @dataclass(frozen=True)
 class Draws:
     """``actor`` draws ``body``'s ``link`` (-1: the base) with its vertices ``vertices`` = ``(start, stop)``
-    (None: all of them), on pyBullet client ``client`` (None: the app's first)."""
+    (None: all of them), on pyBullet client ``client`` (None: the first of the app's clients that has
+    bodies, so an app that keeps an empty client for probes need not name the one it simulates on)."""
 
     actor: Any
     body: int
@@ -78,6 +79,7 @@ def resolve(script, app_module, actors, labels: dict[int, str], counts: list[int
                            "judge the app by attachment alone") from None
     by_actor = {id(a): i for i, a in enumerate(actors)}
     by_frame = {(f.client, f.body, f.link): j for j, f in enumerate(frames)}
+    with_bodies = [c for c in clients if any(f.client == c for f in frames)] or list(clients)
     resolved = []
     for n, entry in enumerate(entries):
         where = f"{path}: entry {n} ({entry!r})"
@@ -88,7 +90,7 @@ def resolve(script, app_module, actors, labels: dict[int, str], counts: list[int
         if index is None:
             raise MappingError(f"{where}: its actor is not one the ShowManager's scene draws "
                                f"({len(actors)} actors: {', '.join(labels.get(id(a), '?') for a in actors[:8])}…)")
-        client = clients[0] if entry.client is None else entry.client
+        client = with_bodies[0] if entry.client is None else entry.client
         frame = by_frame.get((client, int(entry.body), int(entry.link)))
         if frame is None:
             raise MappingError(f"{where}: body {entry.body} link {entry.link} on client {client} does not exist "
