@@ -91,14 +91,17 @@ def _assert_gone(pids: list[int], what: str) -> None:
     assert not left, f"{what} left behind: {left}"
 
 
-def _environment() -> dict[str, str]:
+def _environment(directory) -> dict[str, str]:
     env = {k: v for k, v in os.environ.items() if k != "DISPLAY"}
     env["PYTHONUNBUFFERED"] = "1"
+    # A process killed here cannot remove its temporary files (the crash journal's directory under
+    # pytest-xdist): they go to this test's own directory, which pytest prunes, not the machine's /tmp.
+    env["TMPDIR"] = str(directory)
     return env
 
 
 def _start(argv: list[str], cwd) -> subprocess.Popen:
-    return subprocess.Popen(argv, cwd=cwd, env=_environment(), stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+    return subprocess.Popen(argv, cwd=cwd, env=_environment(cwd), stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                             text=True)
 
 
