@@ -438,7 +438,7 @@ def _wrappers_pass_for_builtins() -> None:
     pybullet function only when ``inspect.isbuiltin`` says it is one; the kit's wrappers are Python
     functions, so without this an app's ``client.stepSimulation()`` would step client 0 instead of its
     own, and the kit would judge a different program (``tests/test_app_mode.py``)."""
-    if getattr(inspect.isbuiltin, "__conformance_stands_in__", False):
+    if getattr(inspect.isbuiltin, "__conformance_patched__", False):
         return
     isbuiltin = inspect.isbuiltin
 
@@ -446,5 +446,5 @@ def _wrappers_pass_for_builtins() -> None:
     def isbuiltin_(obj):
         return isbuiltin(obj) or getattr(obj, "__conformance_stands_in__", False) is True
 
-    isbuiltin_.__conformance_stands_in__ = True
+    isbuiltin_.__conformance_patched__ = True
     inspect.isbuiltin = isbuiltin_
