@@ -19,7 +19,6 @@ from conformance.apps.judge import judge as judge_recording
 import app_recordings as rec
 import app_sources
 
-APP = app_sources.BOX
 ACTOR, BODY = ("ball_actor", "ball") if backends.NAME == "vtk" else ("box", "body")
 
 
@@ -67,9 +66,9 @@ def test_a_mapping_decides_what_attachment_cannot():
     assert verdict.passed and not any("held equally" in n for n in verdict.notes), verdict.notes
 
 
-def _copy(tmp_path, mapping_text: str) -> Path:
+def _copy(tmp_path, mapping_text: str, source: str = app_sources.SOURCE) -> Path:
     app = tmp_path / "sim.py"
-    app.write_text(APP.read_text(encoding="utf-8"), encoding="utf-8")
+    app.write_text(source, encoding="utf-8")
     (tmp_path / "sim.mapping.py").write_text(mapping_text, encoding="utf-8")
     return app
 
@@ -87,8 +86,8 @@ def test_a_mapping_without_a_client_names_the_first_client_with_bodies(tmp_path)
     """The app keeps an empty client 0 and simulates on client 1: ``Draws`` without ``client`` is its box
     there, not a body 'on client 0 that does not exist'."""
     app = _copy(tmp_path, "from conformance.apps.mapping import Draws\n\n"
-                          f"def mapping(app):\n    return [Draws(app.{ACTOR}, app.{BODY})]\n")
-    app.write_text(app_sources.on_a_client_of_its_own(), encoding="utf-8")
+                          f"def mapping(app):\n    return [Draws(app.{ACTOR}, app.{BODY})]\n",
+                source=app_sources.on_a_client_of_its_own())
     result = apps.check_app(app, ticks=10)
     assert [(f.client, f.body) for f in result.recording.frames] == [(1, 0)]
     assert [m["frame"] for m in result.recording.mapping] == [0]
