@@ -1,0 +1,54 @@
+"""``./kit``'s set-up probes: the same answer every time, so set-up installs only what is missing.
+
+Issue 28, point 5: ``ldconfig -p | grep -q libvulkan.so.1`` under ``set -o pipefail`` said "missing" in
+3 runs of 50 with the library installed (grep exits at its first match, ldconfig then dies of SIGPIPE),
+and ``./kit`` ran ``apt-get install`` (as non-root: stopped with "missing system packages").
+"""
+
+from __future__ import annotations
+
+import os
+import stat
+import subprocess
+from pathlib import Path
+
+import pytest
+
+KIT = Path(__file__).resolve().parent.parent / "kit"
+LIBRARIES = ("libGL.so.1", "libXrender.so.1", "libXt.so.6", "libvulkan.so.1")
+
+
+def _fake_ldconfig(directory: Path, libraries) -> None:
+    """An ``ldconfig`` that lists ``libraries`` first, then far more than a pipe holds (64 KiB): a probe
+    that stops reading at its match kills it with SIGPIPE every time, not 3 times in 50."""
+    script = directory / "ldconfig"
+    listed = "".join(f"\t{name} (libc6,x86-64) => /usr/lib/x86_64-linux-gnu/{name}\\n" for name in libraries)
+    script.write_text("#!/usr/bin/env bash\n"
+                      f"printf '{listed}'\n"
+                      "for i in $(seq 20000); do echo \"\tlibfiller$i.so.1 (libc6,x86-64) => /usr/lib/libfiller$i.so.1\"; done\n")
+    script.chmod(script.stat().st_mode | stat.S_IEXEC)
+
+
+def _missing(tmp_path: Path, backend: str) -> list[str]:
+    env = {**os.environ, "PATH": f"{tmp_path}{os.pathsep}{os.environ['PATH']}"}
+    done = subprocess.run([str(KIT), "missing", "--backend", backend], env=env, capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr
+    return done.stdout.split()
+
+
+@pytest.mark.parametrize("backend", ["vtk", "pygfx"])
+def test_a_library_listed_is_found_every_time(tmp_path, backend):
+    """With every library listed, the library probes find each one on every try (20 tries)."""
+    _fake_ldconfig(tmp_path, LIBRARIES)
+    answers = [_missing(tmp_path, backend) for _ in range(20)]
+    libraries = {"libgl1", "libgl1-mesa-dri", "libxrender1", "libxt6", "libvulkan1"}
+    assert all(not (set(a) & libraries) for a in answers), f"libraries said missing although listed: {answers}"
+    assert all(a == answers[0] for a in answers), f"different answers: {answers}"
+
+
+def test_a_library_not_listed_is_missing(tmp_path):
+    """The probe can fail: a library ldconfig does not list is named for installation."""
+    _fake_ldconfig(tmp_path, [name for name in LIBRARIES if name != "libvulkan.so.1"])
+    assert "libvulkan1" in _missing(tmp_path, "pygfx")
+    _fake_ldconfig(tmp_path, [name for name in LIBRARIES if name != "libXt.so.6"])
+    assert "libxt6" in _missing(tmp_path, "vtk")
