@@ -12,6 +12,7 @@ from typing import Any, Mapping
 import numpy as np
 import pytest
 
+from conformance import figures
 from conformance.collisions import Outcome
 
 __all__ = [
@@ -49,6 +50,7 @@ def assert_vector_close(name: str, *, actual, expected, where: str, rtol: float,
     actual, expected = np.asarray(actual, dtype=np.float64), np.asarray(expected, dtype=np.float64)
     error = float(np.linalg.norm(actual - expected))
     bound = atol + rtol * float(np.linalg.norm(expected))
+    figures.note(name, error, bound, where=where)
     if not error <= bound:  # NaN fails
         should = f"{law} = {_vec(expected)}" if law else _vec(expected)
         pytest.fail(f"{name}={_vec(actual)}, but should be {should} (error {error:.3g} > {bound:.3g}) {where}",
@@ -61,6 +63,7 @@ def assert_close(name: str, *, actual: float, expected: float, where: str, rtol:
     __tracebackhide__ = True
     error = abs(actual - expected)
     bound = atol + rtol * abs(expected)
+    figures.note(name, error, bound, where=where)
     if not error <= bound:
         should = f"{law} = {expected:.9g}" if law else f"{expected:.9g}"
         pytest.fail(f"{name}={actual:.9g}, but should be {should} (error {error:.3g} > {bound:.3g}) {where}",
@@ -70,6 +73,8 @@ def assert_close(name: str, *, actual: float, expected: float, where: str, rtol:
 def assert_in_band(name: str, *, actual: float, low: float, high: float, where: str, law: str = "") -> None:
     """low ≤ actual ≤ high."""
     __tracebackhide__ = True
+    # The use of a band is how far from its middle towards an edge: 1 on the edge.
+    figures.note(name, abs(actual - (low + high) / 2), (high - low) / 2, where=where)
     if not (low <= actual <= high):
         pytest.fail(f"{name}={actual:.6g}, but should be in [{low:.6g}, {high:.6g}]"
                     + (f" ({law})" if law else "") + f" {where}", pytrace=False)

@@ -201,6 +201,8 @@ def pytest_configure(config: pytest.Config) -> None:
     load_own_scenes(config)
     _watch_for_crashes(config)
     config.addinivalue_line("markers", "sync: a check that runs the sync implementation under test (added automatically)")
+    config.addinivalue_line("markers", "draws: a check whose examples are drawn at random (Hypothesis; added automatically "
+                            "to a @given check): what `precision` and the kit's random-draw slice run")
     # pytest-xdist registers it itself; without xdist installed the kit's grouping of a scene's checks
     # would otherwise warn as an unknown mark in every run.
     config.addinivalue_line("markers", "xdist_group(name): checks pytest-xdist runs in one worker (one scene's)")
@@ -309,6 +311,9 @@ def pytest_collection_modifyitems(session: pytest.Session, config: pytest.Config
     if placeholders:  # no app configured: the app checks are not collected at all
         items[:] = [item for item in items if item not in placeholders]
         config.hook.pytest_deselected(items=placeholders)
+    for item in items:
+        if _is_property(item):
+            item.add_marker(pytest.mark.draws)
     uses_sync = [item for item in items if "sync_implementation" in getattr(item, "fixturenames", ())]
     for item in uses_sync:
         item.add_marker(pytest.mark.sync)
@@ -363,6 +368,19 @@ def kit(request: pytest.FixtureRequest, sync_implementation):
     return Kit(sync_implementation, tolerance_from(request.config), request.node)
 
 
+#: The figures a check noted (:mod:`conformance.figures`), for its record.
+_FIGURES = pytest.StashKey[dict]()
+
+
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_call(item: pytest.Item):
+    from conformance import figures
+
+    with figures.tally() as kept:
+        item.stash[_FIGURES] = kept
+        return (yield)
+
+
 @pytest.hookimpl(wrapper=True)
 def pytest_runtest_makereport(item: pytest.Item, call):
     report = yield
@@ -394,6 +412,7 @@ def pytest_runtest_makereport(item: pytest.Item, call):
             "verdict": report.outcome,
             "worst": item.stash.get(survey.WORST, None),
             "worst_normals": item.stash.get(survey.WORST_NORMALS, None),
+            "figures": item.stash.get(_FIGURES, {}),
             "kinds": survey.kinds_of(item, report, message),
             "message": message.strip().splitlines()[0][:4000] if message.strip() else "",
             # test_golden_render: each golden frame's sync and renderer verdicts (conformance.rendering.reftest).

@@ -19,7 +19,7 @@ import math
 from hypothesis import HealthCheck, Phase, settings, target
 from hypothesis.control import currently_in_test_context
 
-__all__ = ["CI_FACTOR", "STATEFUL_STEPS", "aim", "app_examples", "check_settings", "describe", "shrinks", "stateful_steps"]
+__all__ = ["CI_FACTOR", "DRAW_FACTOR", "STATEFUL_STEPS", "aim", "app_examples", "check_settings", "describe", "shrinks", "stateful_steps"]
 
 CI_FACTOR = 4
 _SLOW_OK = [HealthCheck.too_slow, HealthCheck.data_too_large, HealthCheck.filter_too_much]
@@ -34,11 +34,28 @@ settings.register_profile("ci", derandomize=True, deadline=None, print_blob=True
 settings.register_profile("triage", derandomize=True, deadline=None, print_blob=True,
                           suppress_health_check=_SLOW_OK, phases=_NO_SHRINK)
 settings.register_profile("shrink", deadline=None, print_blob=True, suppress_health_check=_SLOW_OK, phases=_SHRINK)
+# Random draws in bulk, for measuring false alarms (``python -m conformance precision``): no example
+# database (a draw replayed from an earlier run is not a new draw), nothing shrunk, and
+# :data:`PRECISION_FACTOR` times the default's examples in one process (set by $CONFORMANCE_DRAW_FACTOR).
+settings.register_profile("precision", deadline=None, print_blob=True, suppress_health_check=_SLOW_OK,
+                          database=None, phases=(Phase.explicit, Phase.generate))
 
 #: Examples per profile, as a multiple of what a check asks for under ``default``.
-_FACTORS = {"default": 1, "shrink": 1, "ci": CI_FACTOR, "triage": 1}
+_FACTORS = {"default": 1, "shrink": 1, "ci": CI_FACTOR, "triage": 1, "precision": 1}
 #: Profiles whose counter-examples are reported as found.
-_UNSHRUNK = {"default", "triage"}
+_UNSHRUNK = {"default", "triage", "precision"}
+#: The environment variable that sets the ``precision`` profile's multiple of the default's examples.
+DRAW_FACTOR = "CONFORMANCE_DRAW_FACTOR"
+
+
+def _factor(profile: str) -> int:
+    if profile == "precision":
+        import os
+
+        from conformance import validation
+
+        return validation.whole_number(DRAW_FACTOR, os.environ.get(DRAW_FACTOR, "1"), low=1, high=100_000)
+    return _FACTORS[profile]
 
 
 def _profile() -> str:
@@ -49,7 +66,7 @@ def check_settings(examples: int) -> settings:
     """Settings for a check that wants ``examples`` examples under the fast default profile."""
     profile = _profile()
     if profile in _FACTORS:
-        count = examples * _FACTORS[profile]
+        count = examples * _factor(profile)
     else:
         count = settings.default.max_examples
     if profile in _UNSHRUNK:
@@ -66,12 +83,15 @@ def shrinks() -> bool:
 
 #: Perturbed runs of an app per profile: each is a whole run of the app in its own process (seconds), so
 #: not a multiple of the scene checks' examples.
-_APP_EXAMPLES = {"default": 2, "ci": 3, "triage": 2}
+_APP_EXAMPLES = {"default": 2, "ci": 3, "triage": 2, "precision": 2}
 
 
 def app_examples() -> int:
     """How many perturbed runs ``test_app_perturbed`` makes of each app under the current profile."""
-    return _APP_EXAMPLES.get(_profile(), settings.default.max_examples)
+    profile = _profile()
+    if profile in _APP_EXAMPLES:
+        return _APP_EXAMPLES[profile] * (_factor(profile) if profile == "precision" else 1)
+    return settings.default.max_examples
 
 
 #: Calls per program of the sync-order state machine (conformance/test_sync_order.py) under the kit's
@@ -91,7 +111,8 @@ def describe() -> str:
     how = {"default": "fast, random examples, counter-examples not shrunk",
            "shrink": "random examples, counter-examples shrunk",
            "ci": f"derandomized, x{CI_FACTOR} examples",
-           "triage": "derandomized, counter-examples not shrunk"}.get(profile, "user profile")
+           "triage": "derandomized, counter-examples not shrunk",
+           "precision": f"random, no example database, x{_factor('precision')} examples, not shrunk"}.get(profile, "user profile")
     return f"hypothesis profile {profile!r} ({how})"
 
 

@@ -20,7 +20,7 @@ from typing import Any, Callable, Iterable, Iterator, Mapping, Sequence
 
 import pytest
 
-from conformance import compare, diagnosis, events as events_module, profiles, scenes, survey as survey_module
+from conformance import compare, diagnosis, events as events_module, figures, profiles, scenes, survey as survey_module
 from conformance.errors import SyncError
 from conformance.survey import WORST  # noqa: F401  (where the plugin and older callers find it)
 from conformance.tolerances import Tolerance
@@ -237,6 +237,7 @@ class Kit:
             return
         worst = max(results, key=_by_ratio)
         ratio = worst.error / worst.tolerance if worst.tolerance else worst.error
+        figures.note("vertex position", worst.error, worst.tolerance, where=f"{worst.target!r} frame {worst.frame}")
         if not self.closest >= ratio:  # NaN wins
             self.closest = ratio
         if self._node is None:
@@ -269,6 +270,9 @@ class Kit:
                          first=(lambda: first) if first is not None else (lambda: _vertices_message(failures, run, sync, drawn=drawn())),
                          value=worst.error, limit=worst.tolerance, unit="m", frame=worst.frame, target=worst.target)
         normals = compare.compare_normals(run.drawing, run.frame, self.tolerance)
+        if normals:
+            worst = max(normals, key=lambda r: r.angle / r.tolerance)
+            figures.note("normals angle", worst.angle, worst.tolerance, where=f"{worst.target!r} frame {worst.frame}")
         if normals and self._node is not None:
             worst = max(normals, key=lambda r: r.angle / r.tolerance)
             best = self._node.stash.get(survey_module.WORST_NORMALS, None)

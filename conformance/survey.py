@@ -97,6 +97,7 @@ _FIGURES = (
     ("bounds", re.compile(r"sticks out of getAABB by (\S+) m along \w \(tolerance (\S+) m\)"), "m", False),
     ("bounds", re.compile(r"falls (\S+) m short of getAABB along \w \(margin (\S+) m\)"), "m", False),
     ("every frame = once", re.compile(r"drawn (\S+) m apart .*? within (\S+) m"), "m", False),
+    ("silhouette", re.compile(r"\((\d+) pixels off beyond the edge, (\d+) allowed"), "pixels off", False),
     ("silhouette", re.compile(r"IoU with pyBullet's mask = ([^\s,]+), but should be at least ([^\s,]+)"), "IoU", True),
     ("golden render", re.compile(r"(?:differing|shaded)_fraction (\S+) > ([^\s;]+)"), "of the picture", False),
 )
@@ -213,6 +214,8 @@ def figure_from_message(kind: str, message: str) -> dict[str, Any]:
             new = figure(value=value, limit=limit, unit=unit, at_least=at_least, frame=frame, message=message)
             if worse(new, best):
                 best = new
+        if best is not None and name == kind:  # a kind's first format that matched is its figure (one unit)
+            break
     return best or figure(frame=frame, message=message)
 
 
@@ -308,11 +311,16 @@ def _image_figures(item, report) -> dict[str, dict[str, Any]]:
                          message=record.message)
             kind = "golden render"
         else:
-            if "iou" not in record.metrics or "iou" not in record.limits:
-                continue
             target = re.search(r"silhouette of '([^']*)'", record.message)
-            new = figure(value=record.metrics["iou"], limit=record.limits["iou"], unit="IoU", at_least=True,
-                         frame=record.frame, target=target.group(1) if target else None, message=record.message)
+            target = target.group(1) if target else None
+            if "pixels_off" in record.metrics and "pixels_off" in record.limits:
+                new = figure(value=record.metrics["pixels_off"], limit=record.limits["pixels_off"], unit="pixels off",
+                             frame=record.frame, target=target, message=record.message)
+            elif "iou" in record.metrics and "iou" in record.limits:  # a record of an earlier kit
+                new = figure(value=record.metrics["iou"], limit=record.limits["iou"], unit="IoU", at_least=True,
+                             frame=record.frame, target=target, message=record.message)
+            else:
+                continue
             kind = "silhouette"
         old = found.get(kind)
         new["failures"] = 1 + (old["failures"] if old else 0)

@@ -62,6 +62,7 @@ def test_app(app, check, request, pictures):
                     f"reproduce: {result.reproduce()}", pytrace=False)
 
 
+@pytest.mark.draws
 def test_app_perturbed(app, request, pictures):
     """The app passes every check when the kit turns, kicks and resets its bodies between ticks: a sync
     right only for the motions the app happens to produce fails here."""

@@ -31,6 +31,7 @@ def test_builds_with_defaults(scene_name):
         assert np.isfinite(scene.poses()).all()
 
 
+@pytest.mark.draws
 @each_scene()
 def test_builds_across_parameters(scene_name):
     """Every parameter set the scene's strategy can draw builds, steps and stays finite."""

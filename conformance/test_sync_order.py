@@ -222,6 +222,7 @@ def check_order(kit: Kit, scene_name: str, examples: int = 3) -> None:
              at_least=numbers["at_least"], frame=numbers["frame"])
 
 
+@pytest.mark.draws
 @pytest.mark.parametrize("scene_name", [pytest.param(n, id=n, marks=pytest.mark.scene(n)) for n in SCENES])
 def test_sync_order_follows_any_order_of_calls(scene_name, kit):
     """Steps (1 to 3 between syncs), syncs, two syncs with no step between, teleports, kicks, joint

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from hypothesis import example, given, strategies as st
 
-from conformance import backends, compare, profiles, scenes, shared_run, strategies
+from conformance import backends, compare, figures, profiles, scenes, shared_run, strategies
 from conformance.events import JointReset, Teleport
 from conformance.profiles import check_settings
 from conformance.pytest_helpers import _context, bounds_figure, each_scene, reproduce_command
@@ -83,6 +83,7 @@ def check_every_frame_equals_once(kit, scene_name: str, params: dict, frames: in
             context = _context(run, kit.sync, frames)
     gaps = {name: float(np.nan_to_num(np.abs(drawn[0][name] - drawn[1][name]), nan=np.inf).max()) for name in drawn[0]}
     profiles.aim(max(gaps.values(), default=0.0) / tolerance, "every frame vs once / tolerance")
+    figures.note("every frame vs once", max(gaps.values(), default=0.0), tolerance, where=context)
     for name, gap in gaps.items():
         if not gap <= tolerance:
             kit.fail("every frame = once",
@@ -111,6 +112,7 @@ def test_vertices_match_poses_every_frame(scene_name, kit):
         check_run(kit, scene_name, dict(params), min(spec.steps, EVERY_FRAME))
 
 
+@pytest.mark.draws
 @each_scene()
 def test_vertices_match_through_teleports_and_kicks(scene_name, kit):
     """Hypothesis varies the scene's parameters, the run's length (1 frame up) and what happens
@@ -126,6 +128,7 @@ def test_vertices_match_through_teleports_and_kicks(scene_name, kit):
     check()
 
 
+@pytest.mark.draws
 @each_scene()
 def test_vertices_match_in_every_orientation(scene_name, kit):
     """Every body teleported to an orientation drawn uniformly over rotations or from the cases that
@@ -193,6 +196,7 @@ def test_sync_keeps_the_mesh(scene_name, kit):
     shared_run.report(kit, "test_sync_keeps_the_mesh", scene_name)
 
 
+@pytest.mark.draws
 @each_scene()
 def test_syncing_every_frame_equals_syncing_once(scene_name, kit):
     """Syncing after every step and syncing once after N steps draw the same vertices: a sync depends

@@ -43,3 +43,13 @@ def pytest_sessionfinish(session):
     import background
 
     background.stop()
+
+
+def pytest_report_header(config):
+    """The seed of this run's random-draw slice (``tests/test_random_draws.py``), and how to replay it."""
+    from pathlib import Path
+
+    from conformance import precision
+
+    seed, source = precision.draw_seed(Path(__file__).resolve().parent.parent)
+    return [f"random-draw slice: seed {seed} (from {source}; {precision.SEED_VARIABLE}={seed} replays it)"]

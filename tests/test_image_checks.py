@@ -52,6 +52,7 @@ def silhouette_verdicts(spec: str, scene: str, *, camera=None):
             ids = backends.render_ids(run.drawing, camera or run.scene.camera, run.scene.image_size)
             mask = silhouettes.pybullet_mask(run.scene, run.scene.bindings, run.scene.camera, run.scene.image_size)
             records.append(silhouettes.compare_silhouettes(ids, mask, min_iou=silhouettes.thresholds(run.scene.bindings),
+                                                           rounding=silhouettes.roundings(run.scene.bindings),
                                                            names=[t.name for t in run.drawing.targets]))
     return records
 

@@ -40,8 +40,11 @@ class _Found(Exception):
         self.result = result
 
 
-def search(script, *, examples: int, ticks: int | None = None, tick_function=None, timeout=None, tolerance=None):
-    """The first run of ``examples`` that fails any check, as an :class:`~conformance.apps.AppResult`, or None."""
+def search(script, *, examples: int, ticks: int | None = None, tick_function=None, timeout=None, tolerance=None,
+           seed: int | None = None):
+    """The first run of ``examples`` that fails any check, as an :class:`~conformance.apps.AppResult`, or None.
+    With ``seed``, the runs after the opening are drawn at random from that seed (``app --seed``, and
+    ``precision``, which measures false alarms over random draws); without, derandomized."""
     from conformance import apps
     from conformance.apps import perturb
 
@@ -53,7 +56,7 @@ def search(script, *, examples: int, ticks: int | None = None, tick_function=Non
     if not first.passed or examples == 1:
         return None if first.passed else first
 
-    @settings(max_examples=examples - 1, derandomize=True, database=None, deadline=None, phases=[Phase.generate],
+    @settings(max_examples=examples - 1, derandomize=seed is None, database=None, deadline=None, phases=[Phase.generate],
               suppress_health_check=list(HealthCheck))
     @given(events=strategies.app_events(ticks))
     def run(events):
@@ -62,6 +65,10 @@ def search(script, *, examples: int, ticks: int | None = None, tick_function=Non
         if not result.passed:
             raise _Found(result)
 
+    if seed is not None:
+        from hypothesis import seed as seeded
+
+        run = seeded(seed)(run)
     try:
         run()
     except _Found as found:

@@ -164,11 +164,6 @@ def edges_only(fury: np.ndarray, bullet: np.ndarray, slack: int = silhouettes.SL
     return np.isin(fury, thin) | np.isin(bullet, thin)
 
 
-def _union(target: dict) -> int:
-    """A target's pixels in either mask, from what compare_silhouettes reports (fury + bullet - both)."""
-    return round((target["fury_pixels"] + target["pybullet_pixels"]) / (1 + target["plain_iou"]))
-
-
 def _diagnosis(frame: int, shot: dict, recording, attachments) -> str:
     """``hidden`` when the actors drawing ``frame`` are hidden or mostly too faint; ``stale-gpu`` when the
     GPU holds some of its vertices elsewhere than their arrays; else none."""
@@ -199,6 +194,7 @@ def check(judgement):
     judged, background, unlike = _statuses(judgement)
     names = [f.label for f in r.frames]
     limits = [silhouettes.MIN_IOU.get(f.shapes[0][0], 1.0) if len(f.shapes) == 1 else 1.0 for f in r.frames]
+    rounding = [silhouettes.ROUNDING.get(f.shapes[0][0]) if len(f.shapes) == 1 else None for f in r.frames]
     app = Path(r.script).name
     rounded = {i for i in judged if r.frames[i].shapes[0][0] in ("sphere", "cylinder")}
     worst = None
@@ -218,7 +214,8 @@ def check(judgement):
                                  "both pictures (a sliver, which each renderer's tessellation decides): left out")
             fury[rims], bullet[rims] = -1, -1
         touching = {tuple(p) for p in shot.get("touching", [])}
-        record = silhouettes.compare_silhouettes(fury, bullet, min_iou=limits, names=names, scene=f"app-{Path(r.script).stem}",
+        record = silhouettes.compare_silhouettes(fury, bullet, min_iou=limits, rounding=rounding, names=names,
+                                                 scene=f"app-{Path(r.script).stem}",
                                                  frame=int(shot["tick"]), touching=touching)
         record.sync = "app"
         record.params = {"events": r.events}
@@ -229,9 +226,9 @@ def check(judgement):
                                  "(a shader or texture the kit could not switch off): left out")
         targets = record.details["targets"]
         for t in targets:
-            ratio = (1 - t["iou"]) / max(1 - t["min_iou"], 1e-9)
+            ratio = t["off"] / max(t["allowed_off"], 1)
             worst = ratio if worst is None else max(worst, ratio)
-        failing = [t for t in targets if t["iou"] < t["min_iou"]]
+        failing = [t for t in targets if not t["passed"]]
 
         def why_off(t, shot=shot):
             return _diagnosis(t["index"], shot, r, judgement.attachments) or ("not-its-shape" if t["index"] in unlike else "")
@@ -241,7 +238,7 @@ def check(judgement):
         if failing and not verdict.passed:
             # One picture's bodies in full (the first that fails), the later ones a line each: a wall of
             # bricks hidden for the whole run is one mistake, not one per picture.
-            worst_t = min(failing, key=lambda t: t["iou"] - t["min_iou"])
+            worst_t = max(failing, key=lambda t: t["off"] / max(t["allowed_off"], 1))
             diagnoses = sorted({why_off(t) for t in failing} - {""})
             why = f" [{', '.join(diagnoses)}]" if diagnoses else ""
             bodies = f"{len(failing)} bodies" if len(failing) > 1 else "1 body"
@@ -250,14 +247,13 @@ def check(judgement):
                                  f"{worst_t['iou']:.3f}, at least {worst_t['min_iou']:.2f}){why}")
             verdict.diagnoses.extend(d for d in diagnoses if d not in verdict.diagnoses)
             continue
-        for t in sorted(failing, key=lambda t: t["iou"] - t["min_iou"]):
+        for t in sorted(failing, key=lambda t: -t["off"] / max(t["allowed_off"], 1)):
             verdict.passed = False
-            union = _union(t)
             diagnosis = why_off(t)
             verdict.lines.append(
                 f"{app}, tick {shot['tick']}: {t['target']} is not where pyBullet's renderer draws it from the app's camera: "
-                f"{round((1 - t['iou']) * union)} pixels off beyond the {record.details['slack']} px edge slack, "
-                f"{int((1 - t['min_iou']) * union)} allowed (IoU {t['iou']:.3f}, at least {t['min_iou']:.2f}; "
+                f"{t['off']} pixels off beyond the {record.details['slack']} px edge slack, "
+                f"{t['allowed_off']} allowed (IoU {t['iou']:.3f}, at least {t['min_iou']:.2f}; "
                 f"{t['fury_pixels']} FURY pixels, {t['pybullet_pixels']} pyBullet pixels; {shot['size'][0]}x{shot['size'][1]} "
                 f"picture){f' [{diagnosis}]' if diagnosis else ''}")
             if diagnosis:

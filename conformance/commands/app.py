@@ -18,6 +18,8 @@ def add_arguments(parser) -> None:
                         "may end sooner with showm.exit())")
     parser.add_argument("--perturbed", default="3", metavar="K", help="runs with the kit's teleports, kicks and joint "
                         "resets drawn by Hypothesis between ticks (default 3; 0 for none)")
+    parser.add_argument("--seed", default=None, metavar="S", help="draw the perturbed runs at random from this seed "
+                        "(default: derandomized, the same runs every time)")
     parser.add_argument("--events", default=None, help="one run with these events (JSON, from a failure's reproduce line)")
     parser.add_argument("--tick", default=None, metavar="NAME", help="a module-level function of the app to call once "
                         "a tick, for an app whose loop is its own")
@@ -65,6 +67,7 @@ def run(args, extra) -> int:
                                                                                   high=validation.MAX_STEPS)
     runs = validation.whole_number("--perturbed", args.perturbed, low=0, high=1000)
     timeout = validation.finite_non_negative("--timeout", args.timeout)
+    seed = None if args.seed is None else validation.whole_number("--seed", args.seed)
     events = None
     if args.events is not None:
         from conformance.apps import perturb
@@ -86,9 +89,10 @@ def run(args, extra) -> int:
         _print_result(result, "own run" if not events else "run with the given events", results)
         ok = result.passed
         if ok and events is None and runs:
-            found = perturbed.search(path, examples=runs, tick_function=args.tick, timeout=timeout)
+            found = perturbed.search(path, examples=runs, tick_function=args.tick, timeout=timeout, seed=seed)
             if found is None:
-                print(f"  PASS perturbed: {runs} runs of {apps.PERTURBED_TICKS} ticks with the kit's teleports, kicks and joint resets")
+                drawn = "" if seed is None else f", drawn from seed {seed}"
+                print(f"  PASS perturbed: {runs} runs of {apps.PERTURBED_TICKS} ticks with the kit's teleports, kicks and joint resets{drawn}")
             else:
                 ok = False
                 _print_result(found, f"perturbed run (events {json.dumps(found.events)}; not shrunk)", results)

@@ -27,23 +27,31 @@ also turns the ground: boxes 0.987, spheres 0.990, cylinders 0.722 (a cylinder c
 ground, where the tiny renderer's depth test draws the cut differently). Before pixels of bodies in
 contact were left out, 1 draw in 300 failed a right sync (that cylinder: 13 FURY pixels against 68).
 Hence ``MIN_IOU``: 0.98 for boxes and spheres, 0.7 for cylinders (weak: a cylinder is judged
-coarsely). Measured: a box moved by 2 px gives 0.969 (fails); a 3° turn of a 55 px box is NOT caught
+coarsely). Those draws were the orientation property's, at the scenes' default parameters; over the
+scenes' own parameter space two more things a right sync does not control showed (issue 28): a small
+body has a few pixels off at a corner or a seam, more than 2 % of it (a 72-pixel brick, 3 pixels:
+:data:`LEAST_OFF`), and a sphere large on screen is drawn by pyBullet as a coarse hull up to 7.5 % of
+its radius inside FURY's finer one (free_fall's 1 m sphere, 5 px: :data:`ROUNDING`). Measured: a box moved by 2 px gives 0.969 (fails); a 3° turn of a 55 px box is NOT caught
 with the 1 px slack (plain IoU 0.96-0.97, slack IoU 1.0); a 10 % wrong view angle or a 3 cm shifted
 focal point fails.
 """
 
 from __future__ import annotations
 
+import math
 from typing import Sequence
 
 import numpy as np
 import pybullet
 from scipy import ndimage
 
+from conformance import figures
+
 from . import projection
 from .records import ImageCheck
 
-__all__ = ["MIN_IOU", "MIN_PIXELS", "SLACK", "TOUCHING", "compare_silhouettes", "mask_images", "pybullet_mask", "thresholds", "touching_pairs"]
+__all__ = ["LEAST_OFF", "MIN_IOU", "MIN_PIXELS", "ROUNDING", "SLACK", "TOUCHING", "compare_silhouettes", "mask_images",
+           "pybullet_mask", "rounded_slacks", "roundings", "thresholds", "touching_pairs"]
 
 #: A target is judged only where it covers at least this many pixels in either mask: below that its
 #: IoU is dominated by which edge pixels each rasteriser keeps.
@@ -58,6 +66,23 @@ HALF_PIXEL = True
 
 #: Pixels a silhouette's edge may be off before a mismatch counts (see :func:`compare_silhouettes`).
 SLACK = 1
+
+#: Pixels off (beyond the edge slack) that any target may have, however small: what rasterising a corner
+#: seen edge-on or a seam between two bodies flips. Measured with the reference sync over 4,200 random
+#: draws of every scene's parameters and run length (FURY 0.12): at most 2 on a box or sphere under 300
+#: pixels; 3 on a 72-pixel brick of a random wall (the wrecking ball, ``--hypothesis-seed=5``: 0.959
+#: against 0.98, a right sync rejected). Twice that: a box moved by 2 px is off by a pixel along two of
+#: its sides, 14 pixels for the smallest judged box (50 pixels).
+LEAST_OFF = 6
+
+#: How far inside a sphere's true outline each renderer's tessellated outline may fall, as a fraction of
+#: its radius on screen, (FURY's, pyBullet's). pyBullet's tiny renderer draws a sphere as a coarse hull:
+#: up to 0.0748 of the radius inside, measured over 200 orientations of a 160-px sphere
+#: (tests/test_silhouettes.py); FURY's spheres are 16 x 16 UV spheres, whose hull lies at most 0.024 of
+#: the radius inside (1 - cos 12.6°, the half diagonal of an equatorial face; measured on the kit's mesh
+#: in tests/test_silhouettes.py). Without it a right sync failed every random draw that made a sphere
+#: large on screen: free_fall's sphere at 31,000 pixels, IoU 0.962, pyBullet's outline 5 px inside FURY's.
+ROUNDING = {"sphere": (0.03, 0.08)}
 
 
 def pybullet_mask(scene, bindings: Sequence, camera, size, *, depth: bool = False):
@@ -84,16 +109,34 @@ def pybullet_mask(scene, bindings: Sequence, camera, size, *, depth: bool = Fals
     return out
 
 
-def _far_mismatch(a: np.ndarray, b: np.ndarray, slack: int) -> int:
-    """Pixels in exactly one of masks ``a`` and ``b`` that are more than ``slack`` pixels (chessboard
-    distance) from the other mask: what a different tessellation or rasterisation of the same edge
-    cannot explain."""
+def _far_mismatch(a: np.ndarray, b: np.ndarray, slack_a: int, slack_b: int | None = None) -> int:
+    """Pixels in exactly one of masks ``a`` and ``b`` that are far from the other mask: those only in
+    ``a`` more than ``slack_a`` pixels (chessboard distance) from ``b``, those only in ``b`` more than
+    ``slack_b`` (default ``slack_a``) from ``a``: what a different tessellation or rasterisation of the
+    same edge cannot explain."""
+    slack_b = slack_a if slack_b is None else slack_b
+    return int(np.count_nonzero(a & ~_near(b, slack_a)) + np.count_nonzero(b & ~_near(a, slack_b)))
+
+
+def _near(mask: np.ndarray, slack: int) -> np.ndarray:
+    """``mask`` grown by ``slack`` pixels (chessboard distance)."""
     if slack <= 0:
-        return int(np.count_nonzero(a ^ b))
-    structure = np.ones((2 * slack + 1, 2 * slack + 1), dtype=bool)
-    near_a = ndimage.binary_dilation(a, structure)
-    near_b = ndimage.binary_dilation(b, structure)
-    return int(np.count_nonzero(a & ~near_b) + np.count_nonzero(b & ~near_a))
+        return mask
+    return ndimage.binary_dilation(mask, np.ones((2 * slack + 1, 2 * slack + 1), dtype=bool))
+
+
+def rounded_slacks(pixels: int, rounding: tuple[float, float] | None, slack: int = SLACK) -> tuple[int, int]:
+    """``(fury_only, pybullet_only)``: how many pixels from the other mask a pixel only in FURY's, only in
+    pyBullet's, mask of a target may lie and be put down to the edge, for a target covering ``pixels``
+    pixels. For a sphere (``rounding`` = the two renderers' :data:`ROUNDING`) each renderer's outline may
+    lie inside the true one by its tessellation's depth, a fraction of the radius on screen (taken as
+    that of a disc of ``pixels`` pixels): pixels only FURY draws are explained up to pyBullet's depth,
+    pixels only pyBullet draws up to FURY's."""
+    if rounding is None:
+        return slack, slack
+    radius = math.sqrt(pixels / math.pi)
+    fury, bullet = rounding
+    return slack + math.ceil(bullet * radius), slack + math.ceil(fury * radius)
 
 
 def touching_pairs(scene, bindings: Sequence, ids_fury: np.ndarray, ids_pybullet: np.ndarray,
@@ -113,19 +156,27 @@ def touching_pairs(scene, bindings: Sequence, ids_fury: np.ndarray, ids_pybullet
 
 def compare_silhouettes(ids_fury: np.ndarray, ids_pybullet: np.ndarray, *, min_pixels: int = MIN_PIXELS,
                         min_iou=0.95, slack: int = SLACK, names: Sequence[str] = (), scene: str = "",
-                        frame: int = 0, touching: set[tuple[int, int]] | None = None) -> ImageCheck:
+                        frame: int = 0, touching: set[tuple[int, int]] | None = None,
+                        rounding: Sequence[tuple[float, float] | None] | None = None,
+                        least_off: int = LEAST_OFF) -> ImageCheck:
     """Per target, how well FURY's silhouette and pyBullet's agree, for every target covering at least
     ``min_pixels`` pixels in either mask; passes when each such target's IoU is at least its ``min_iou``
-    (one number for every target, or a sequence indexed by target, e.g. :func:`thresholds`).
+    (one number for every target, or a sequence indexed by target, e.g. :func:`thresholds`), or when it
+    has no more than ``least_off`` pixels off (:data:`LEAST_OFF`: what rasterising a corner or a seam
+    flips, which on a small body is more than its share of the IoU).
 
     Pixels where the two masks show two different targets of a ``touching`` pair (:func:`touching_pairs`)
     are left out (which of two bodies in contact is in front is the renderers' business, where each
     body is the sync's). The IoU is taken with an edge slack: a pixel in one mask only counts against the target if it is
-    more than ``slack`` pixels from the other mask, so ``iou = 1 - far / union`` (``slack=0``: the plain
-    intersection over union, also reported per target as ``plain_iou``). ``names`` name the targets."""
+    more than ``slack`` pixels from the other mask, so ``iou = 1 - off / union`` (``slack=0``: the plain
+    intersection over union, also reported per target as ``plain_iou``). A target with a ``rounding``
+    (:func:`roundings`: a sphere) has the slack of :func:`rounded_slacks` instead, and so do the pixels
+    where its outline meets another target. ``names`` name the targets."""
     if ids_fury.shape != ids_pybullet.shape:
         raise ValueError(f"mask shapes differ: {ids_fury.shape} vs {ids_pybullet.shape}")
     count = int(max(ids_fury.max(initial=-1), ids_pybullet.max(initial=-1), len(names) - 1)) + 1
+    rounding = list(rounding) if rounding is not None else []
+    rounding += [None] * (count - len(rounding))
     # Where two bodies touch or interpenetrate, which one is in front depends on each renderer's
     # tessellation and depth test (measured: a cylinder cut by a turned ground, 13 FURY pixels against
     # 68 pyBullet pixels, 1 draw in 300 of the orientation property, with the reference sync). Pixels
@@ -133,7 +184,20 @@ def compare_silhouettes(ids_fury: np.ndarray, ids_pybullet: np.ndarray, *, min_p
     # apart, a different one in front is a body drawn in the wrong place, and counts.
     pair_ids = np.minimum(ids_fury, ids_pybullet).astype(np.int64) * (1 << 20) + np.maximum(ids_fury, ids_pybullet)
     allowed = np.array([i * (1 << 20) + j for i, j in (touching or ())], dtype=np.int64)
-    contested = (ids_fury >= 0) & (ids_pybullet >= 0) & (ids_fury != ids_pybullet) & np.isin(pair_ids, allowed)
+    differ = (ids_fury >= 0) & (ids_pybullet >= 0) & (ids_fury != ids_pybullet)
+    contested = differ & np.isin(pair_ids, allowed)
+    fury = np.bincount(ids_fury.ravel() + 1, minlength=count + 1)[1:]
+    bullet = np.bincount(ids_pybullet.ravel() + 1, minlength=count + 1)[1:]
+    # A sphere in front of another body: where its two outlines differ (each renderer's tessellation), one
+    # picture shows the body behind and the other the sphere; those pixels are the sphere's edge, not the
+    # other body's, and are left out of both as far as the sphere's own slack reaches.
+    if differ.any():
+        for k in set(np.unique(np.concatenate([ids_fury[differ], ids_pybullet[differ]])).tolist()):
+            if rounding[k] is None:
+                continue
+            fury_only, bullet_only = rounded_slacks(int(max(fury[k], bullet[k])), rounding[k], slack)
+            contested |= differ & (((ids_fury == k) & _near(ids_pybullet == k, fury_only))
+                                   | ((ids_pybullet == k) & _near(ids_fury == k, bullet_only)))
     fury_ids = np.where(contested, -1, ids_fury)
     bullet_ids = np.where(contested, -1, ids_pybullet)
     fury = np.bincount(fury_ids.ravel() + 1, minlength=count + 1)[1:]
@@ -143,37 +207,54 @@ def compare_silhouettes(ids_fury: np.ndarray, ids_pybullet: np.ndarray, *, min_p
     targets = []
     for i in np.flatnonzero(np.maximum(fury, bullet) >= min_pixels):
         a, b = fury_ids == i, bullet_ids == i
+        fury_only, bullet_only = rounded_slacks(int(max(fury[i], bullet[i])), rounding[i], slack)
+        grow = max(fury_only, bullet_only)
         rows, cols = np.nonzero(a | b)  # work on the target's box, grown by the slack, not the whole picture
-        box = (slice(max(rows.min() - slack, 0), rows.max() + slack + 1),
-               slice(max(cols.min() - slack, 0), cols.max() + slack + 1))
+        box = (slice(max(rows.min() - grow, 0), rows.max() + grow + 1),
+               slice(max(cols.min() - grow, 0), cols.max() + grow + 1))
         union = int(fury[i] + bullet[i] - both[i])
+        off = _far_mismatch(a[box], b[box], fury_only, bullet_only)
         targets.append({"target": names[i] if i < len(names) else f"#{i}", "index": int(i),
-                        "iou": 1.0 - _far_mismatch(a[box], b[box], slack) / union,
-                        "plain_iou": float(both[i] / union),
+                        "iou": 1.0 - off / union, "plain_iou": float(both[i] / union), "off": off,
+                        "allowed_off": max(least_off, int((1.0 - limits[i]) * union)),
+                        "slack": [fury_only, bullet_only],
                         "fury_pixels": int(fury[i]), "pybullet_pixels": int(bullet[i]), "min_iou": limits[i]})
-    # The worst target is the one furthest below (or least above) its own threshold.
-    worst = min(targets, key=lambda t: t["iou"] - t["min_iou"], default=None)
+    for t in targets:
+        t["passed"] = t["iou"] >= t["min_iou"] or t["off"] <= least_off
+    # The worst target is the one furthest over its allowance of pixels off.
+    worst = max(targets, key=lambda t: t["off"] / max(t["allowed_off"], 1), default=None)
     where = f"[{scene}, frame {frame}]"
-    details = {"targets": targets, "min_pixels": min_pixels, "slack": slack}
+    details = {"targets": targets, "min_pixels": min_pixels, "slack": slack, "least_off": least_off}
     if worst is None:
         return ImageCheck(kind="silhouette", scene=scene, frame=frame, passed=True, details=details,
                           message=f"no target covers {min_pixels} pixels in either mask {where}")
-    passed = all(t["iou"] >= t["min_iou"] for t in targets)
+    figures.note("silhouette pixels off", worst["off"], max(worst["allowed_off"], 1), where=f"{worst['target']!r} {where}")
+    passed = all(t["passed"] for t in targets)
     min_iou = worst["min_iou"]
+    edge = (f"edge slack {slack} px" if worst["slack"] == [slack, slack] else
+            f"edge slack {worst['slack'][0]} px for FURY's pixels, {worst['slack'][1]} px for pyBullet's (a sphere's tessellation)")
     message = (f"silhouette of {worst['target']!r}: IoU with pyBullet's mask = {worst['iou']:.3f}"
                f"{', but should be at least' if not passed else ' (at least'} {min_iou:.3f}{'' if not passed else ')'}"
-               f" ({worst['fury_pixels']} FURY pixels, {worst['pybullet_pixels']} pyBullet pixels, plain IoU "
-               f"{worst['plain_iou']:.3f}, edge slack {slack} px) {where}")
-    failing = [t["target"] for t in targets if t["iou"] < t["min_iou"]]
+               f" ({worst['off']} pixels off beyond the edge, {worst['allowed_off']} allowed; {worst['fury_pixels']} FURY "
+               f"pixels, {worst['pybullet_pixels']} pyBullet pixels, plain IoU {worst['plain_iou']:.3f}, {edge}) {where}")
+    failing = [t["target"] for t in targets if not t["passed"]]
     if len(failing) > 1:
         message += f"; {len(failing)} targets below it: {', '.join(failing[:10])}"
+    # The bound is on pixels off; the IoU is told beside it (a small body passes below its IoU with a
+    # corner's few pixels off).
     return ImageCheck(kind="silhouette", scene=scene, frame=frame, passed=passed, message=message,
-                      metrics={"iou": worst["iou"]}, limits={"iou": float(min_iou)}, details=details)
+                      metrics={"pixels_off": worst["off"], "iou": worst["iou"]},
+                      limits={"pixels_off": worst["allowed_off"]}, details=details)
 
 
 def thresholds(bindings: Sequence) -> list[float]:
     """Each binding's ``min_iou``, by the kind of its shape (:data:`MIN_IOU`)."""
     return [MIN_IOU[b.shape.kind] for b in bindings]
+
+
+def roundings(bindings: Sequence) -> list[tuple[float, float] | None]:
+    """Each binding's :data:`ROUNDING` (None for a shape both renderers draw exactly)."""
+    return [ROUNDING.get(b.shape.kind) for b in bindings]
 
 
 def _palette(count: int) -> np.ndarray:
