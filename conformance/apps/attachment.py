@@ -41,6 +41,8 @@ FIRST = 4
 NEAREST = 32
 #: ticks compared when choosing a vertex's frame (all ticks are compared once it is chosen)
 PROBES = 8
+#: a vertex this close (m) to a welded frame's collision shape lies on it
+ON_SHAPE = 1e-4
 
 
 @dataclass
@@ -55,6 +57,8 @@ class Attachment:
     allowance: np.ndarray  # (n,) float
     reference: np.ndarray  # (n, 3)
     tied: np.ndarray       # (n,) bool
+    #: held by frames welded together (:mod:`conformance.apps.welds`), and given to the one whose shape it lies on
+    welded: np.ndarray | None = None
 
     @functools.cached_property
     def held(self) -> np.ndarray:
@@ -98,7 +102,8 @@ def _probes(ticks: int, extra=()) -> np.ndarray:
 
 
 def attach(vertices: np.ndarray, positions: np.ndarray, rotations: np.ndarray, *, tolerance: Tolerance = DEFAULT,
-           event_ticks=(), centres: np.ndarray | None = None, radii: np.ndarray | None = None) -> Attachment:
+           event_ticks=(), centres: np.ndarray | None = None, radii: np.ndarray | None = None,
+           groups: np.ndarray | None = None, outside=None) -> Attachment:
     """Find the frame holding each vertex and its error at every tick.
 
     ``vertices`` ``(T, n, 3)`` are one actor's drawn vertices at the judged ticks; ``positions``
@@ -107,7 +112,9 @@ def attach(vertices: np.ndarray, positions: np.ndarray, rotations: np.ndarray, *
     :data:`NEAREST` nearest, then in every frame (so a range following a far-away body is still found).
     ``centres`` ``(F, 3)`` and ``radii`` ``(F,)`` are the frames' collision shapes (centre in the frame,
     bounding radius), to choose between frames that hold a vertex equally; by default the frame origins
-    and 1 m."""
+    and 1 m. ``groups`` ``(F,)`` are the welded frames (:func:`conformance.apps.welds.groups`): a vertex
+    held by one of them goes to the member whose shape it lies on (``outside(frame, points)``: how far
+    link-frame points lie outside the frame's shapes), whichever of them it was tried in."""
     ticks, n, _ = vertices.shape
     frames = positions.shape[1]
     centres = np.zeros((frames, 3)) if centres is None else np.asarray(centres, dtype=np.float64)
@@ -169,9 +176,43 @@ def attach(vertices: np.ndarray, positions: np.ndarray, rotations: np.ndarray, *
         allowance = _allowance(vertices, pos, rot, best, tolerance)
         local = local_coordinates(vertices, pos[:, best], rot[:, best])
         error = np.linalg.norm(local - np.median(local, axis=0), axis=-1).T
+    welded = np.zeros(n, dtype=bool)
+    if groups is not None and n and frames:
+        best, welded = _on_welded_shape(vertices[0], pos[0], rot[0], best, np.asarray(groups), centres, radii, outside)
+        if welded.any():
+            tied = tied & ~welded
+            allowance = _allowance(vertices, pos, rot, best, tolerance)
+            local = local_coordinates(vertices, pos[:, best], rot[:, best])
+            error = np.linalg.norm(local - np.median(local, axis=0), axis=-1).T
     reference = np.median(local, axis=0)
     frame = np.where(best == frames, -1, best)
-    return Attachment(frame=frame, error=error, allowance=allowance, reference=reference, tied=tied)
+    return Attachment(frame=frame, error=error, allowance=allowance, reference=reference, tied=tied, welded=welded)
+
+
+def _on_welded_shape(vertices0, pos0, rot0, best, groups, centres, radii, outside=None):
+    """``best`` with each vertex held by a welded frame moved to the member of its group whose shape it
+    lies on (closest to it by ``outside``, then closest to the shape's centre over its radius), and which
+    vertices were welded."""
+    frames = len(groups)
+    in_group = (best < frames) & (groups[np.minimum(best, frames - 1)] >= 0)
+    welded = np.zeros(len(best), dtype=bool)
+    best = best.copy()
+    for group in np.unique(groups[best[in_group]]):
+        rows = np.flatnonzero(in_group & (groups[np.minimum(best, frames - 1)] == group))
+        members = np.flatnonzero(groups == group)
+        candidates = np.broadcast_to(members, (len(rows), len(members)))
+        distance = _shape_distance(vertices0[rows], pos0, rot0, candidates, centres, radii)
+        if outside is not None:
+            # On a shape first (within a tenth of a millimetre); a vertex on several (where a leg meets the
+            # body) goes with the member most of this actor's vertices lie on alone; else the most central.
+            gaps = np.stack([outside(int(f), _transposed_times(rot0[f], vertices0[rows] - pos0[f])) for f in members], 1)
+            on = gaps <= ON_SHAPE
+            alone = on & (on.sum(axis=1, keepdims=True) == 1)
+            votes = alone.sum(axis=0)
+            distance = np.where(on, -votes[None, :] * 1e6 + np.minimum(distance, 1e5), 1e12 + gaps)
+        best[rows] = members[np.argmin(distance, axis=1)]
+        welded[rows] = True
+    return best, welded
 
 
 def _shape_distance(vertices0, pos0, rot0, candidates, centres, radii) -> np.ndarray:

@@ -43,6 +43,9 @@ class Frame:
     mass: float
     shapes: tuple
     inertial: tuple = (0.0, 0.0, 0.0)  # the centre of mass in the link frame (getDynamicsInfo()[3])
+    #: the vertices of its mesh collision shapes in its link frame (``getMeshData``, which pyBullet gives in
+    #: the centre-of-mass frame; URDF cylinders are meshes there too), at most :data:`MESH_VERTICES` of them
+    mesh: tuple = ()
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -57,6 +60,29 @@ class Frame:
 
 def _text(value) -> str:
     return value.decode("utf-8", "replace") if isinstance(value, bytes) else str(value)
+
+
+#: A frame keeps at most this many of its collision mesh's vertices (evenly picked): enough for the box
+#: and the sphere around it, small in a recording.
+MESH_VERTICES = 4096
+
+
+def _mesh(p: BoundClient, body: int, link: int, shapes: tuple) -> tuple:
+    """The frame's collision mesh vertices in its link frame, for a frame with a mesh shape; else ()."""
+    if not any(kind == "mesh" for kind, *_ in shapes):
+        return ()
+    try:
+        count, vertices = p.getMeshData(body, link)[:2]
+    except pybullet.error:
+        return ()
+    if not count:
+        return ()
+    vertices = np.asarray(vertices, dtype=np.float64)
+    if len(vertices) > MESH_VERTICES:
+        vertices = vertices[np.linspace(0, len(vertices) - 1, MESH_VERTICES).round().astype(int)]
+    inertial_pos, inertial_orn = p.getDynamicsInfo(body, link)[3:5]
+    turned = poses.apply(inertial_pos, inertial_orn, vertices)
+    return tuple(tuple(round(float(c), 9) for c in v) for v in turned)
 
 
 def _shapes(p: BoundClient, body: int, link: int) -> tuple:
@@ -78,12 +104,12 @@ def frames_of(clients) -> list[Frame]:
             body = p.getBodyUniqueId(index)
             base_name, body_name = (_text(v) for v in p.getBodyInfo(body))
             name = body_name if body_name and body_name != base_name else base_name
-            info = p.getDynamicsInfo(body, -1)
-            frames.append(Frame(client, body, -1, name, float(info[0]), _shapes(p, body, -1), tuple(info[3])))
-            for link in range(p.getNumJoints(body)):
-                link_name = _text(p.getJointInfo(body, link)[12])
+            for link in range(-1, p.getNumJoints(body)):
                 info = p.getDynamicsInfo(body, link)
-                frames.append(Frame(client, body, link, link_name, float(info[0]), _shapes(p, body, link), tuple(info[3])))
+                shapes = _shapes(p, body, link)
+                label = name if link == -1 else _text(p.getJointInfo(body, link)[12])
+                frames.append(Frame(client, body, link, label, float(info[0]), shapes, tuple(info[3]),
+                                    _mesh(p, body, link, shapes)))
     return frames
 
 

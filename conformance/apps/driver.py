@@ -322,8 +322,11 @@ class _Track:
         self.missed: list[tuple[int, str]] = []
         self._state = None
         self.gpu: np.ndarray | None = None  # FURY 2: the positions as the GPU holds them (None on VTK)
+        self.radii: np.ndarray | None = None  # FURY 2's impostor spheres: each vertex's sphere radius
 
     def snapshot(self) -> None:
+        if not self.vertices:
+            self.radii = self.backend.impostor_radii(self.actor)
         self.vertices.append(np.array(self.backend.world_vertices(self.actor), dtype=np.float64))
         normals = self.backend.world_normals(self.actor)
         if normals is not None:
@@ -363,7 +366,7 @@ class _Track:
         kind = type(self.actor).__name__
         normals = np.array(self.normals) if len(self.normals) == ticks else None
         return ActorTrack(self.label, kind, np.array(self.vertices), normals,
-                          np.array(self.changed), np.array(self.announced), list(self.missed))
+                          np.array(self.changed), np.array(self.announced), list(self.missed), self.radii)
 
 
 def install_pybullet(driver: Driver) -> None:

@@ -24,8 +24,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from conformance.apps import attachment as attach_mod
-from conformance.apps.placement import bounding_radius, bounding_sphere, place
+from conformance.apps import attachment as attach_mod, welds
+from conformance.apps.placement import bounding_radius, bounding_sphere, distance_to_shapes, place
 from conformance.apps.recording import Recording
 from conformance.tolerances import DEFAULT, Tolerance
 
@@ -92,11 +92,15 @@ class _Judgement:
         self.orn = recording.orientations[1:]
         self.rot = _rotations(self.orn) if self.orn.size else np.zeros(self.orn.shape[:-1] + (3, 3))
         self.event_ticks = sorted({int(e["frame"]) - 1 for e in recording.events})
-        spheres = [bounding_sphere(f.shapes) for f in recording.frames]
+        spheres = [bounding_sphere(f.shapes, f.mesh) for f in recording.frames]
         centres = np.array([c for c, _ in spheres]).reshape(-1, 3)
         radii = np.array([r for _, r in spheres])
+        #: frames welded together (fixed joints): one rigid frame, whose vertices go to the member they lie on
+        self.welds = welds.groups(recording.frames, recording.positions, _rotations(recording.orientations)) \
+            if recording.frames else np.zeros(0, int)
         self.attachments = [attach_mod.attach(a.vertices[1:], self.pos, self.rot, tolerance=tolerance,
-                                              event_ticks=self.event_ticks, centres=centres, radii=radii)
+                                              event_ticks=self.event_ticks, centres=centres, radii=radii,
+                                              groups=self.welds, outside=self._outside)
                             for a in recording.actors] \
             if recording.ticks else []
         self.mapped = [np.zeros(len(a.frame), dtype=bool) for a in self.attachments]
@@ -105,6 +109,11 @@ class _Judgement:
         self.followed_badly: set[int] = set()
         self._attached_done = False
         self._placements = None
+
+    def _outside(self, frame: int, points: np.ndarray) -> np.ndarray:
+        """How far link-frame ``points`` lie outside ``frame``'s collision shapes (0 on or inside)."""
+        info = self.r.frames[frame]
+        return distance_to_shapes(points, info.shapes, info.mesh)
 
     def _apply_mapping(self, entry: dict) -> None:
         """Judge the mapped vertices in the frame the mapping names, not the one that holds them best:
@@ -170,6 +179,15 @@ class _Judgement:
                     verdict.diagnoses.append(diagnosis)
         for entry in self.r.mapping:
             self._judge_mapped(entry, verdict)
+        welded = sum(int(a.welded.sum()) for a in self.attachments if a.welded is not None)
+        if welded:
+            groups = {}
+            for i, g in enumerate(self.welds):
+                if g >= 0:
+                    groups.setdefault(int(g), []).append(self.r.frames[i].name or self.frame_label(i))
+            together = "; ".join(" + ".join(names) for names in groups.values())
+            verdict.notes.append(f"{welded} vertices are held by frames welded together (fixed joints, or links that never "
+                                 f"moved apart: {together}): each went to the frame whose collision shape it lies on")
         verdict.worst = worst
         return verdict
 
@@ -352,8 +370,9 @@ class _Judgement:
                     rows = np.flatnonzero((a.frame == frame) & a.held)
                     if not len(rows):
                         continue
-                    result = place(a.reference[rows], self.r.frames[frame].shapes, self._inertial(frame),
-                                   tolerance=self.tolerance)
+                    info = self.r.frames[frame]
+                    result = place(_drawn_points(a.reference[rows], track.radii, rows), info.shapes,
+                                   self._inertial(frame), tolerance=self.tolerance)
                     self._placements.append((track, a, int(frame), rows, result))
         return self._placements
 
@@ -389,6 +408,10 @@ class _Judgement:
         worst = 0.0
         for track, a in zip(self.r.actors, self.attachments):
             if track.normals is None:
+                continue
+            if track.radii is not None:  # a shader lights impostor spheres as spheres: no stored normal is used
+                verdict.notes.append(f"{track.label}: spheres drawn by a shader (impostors), lit as spheres whatever "
+                                     "their stored normals: not judged")
                 continue
             frames = a.frame
             rot = np.concatenate([self.rot, np.broadcast_to(np.eye(3), self.rot.shape[:1] + (1, 3, 3))], axis=1)
@@ -464,6 +487,17 @@ class _Judgement:
             verdict.diagnoses.append("written-back")
         verdict.worst = float(change.max())
         return verdict
+
+
+def _drawn_points(reference: np.ndarray, radii: np.ndarray | None, rows: np.ndarray) -> np.ndarray:
+    """What a drawing covers, in its frame: its vertices; for an impostor sphere (a vertex at its centre,
+    :attr:`~conformance.apps.recording.ActorTrack.radii`) the six points of its sphere on the frame's axes,
+    so that it spans the box of the sphere it draws."""
+    if radii is None:
+        return reference
+    r = radii[rows][:, None, None]
+    axes = np.concatenate([np.eye(3), -np.eye(3)])[None]
+    return (reference[:, None, :] + r * axes).reshape(-1, 3)
 
 
 def _runs(mask: np.ndarray, frames: np.ndarray):

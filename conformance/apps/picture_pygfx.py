@@ -55,6 +55,38 @@ def _alpha(actor) -> np.ndarray:
     return alpha
 
 
+#: The twin of an impostor sphere: a UV sphere this fine (its outline lies at most 0.6 % of the radius
+#: inside the true one, within the silhouettes' rounding allowance for FURY's side).
+SPHERE_SEGMENTS = 32
+
+
+def _spheres(centres: np.ndarray, radii: np.ndarray, faces_of: np.ndarray, codes: np.ndarray):
+    """One mesh of a sphere per billboard of an impostor actor: billboard ``k`` is the vertices from its
+    first face's first vertex; its sphere is centred there with its radius (local units), every face in
+    the code colour of the billboard's first face."""
+    import pygfx
+    from fury import primitive
+
+    unit, triangles = primitive.prim_sphere(phi=SPHERE_SEGMENTS, theta=SPHERE_SEGMENTS)
+    unit = np.asarray(unit, dtype=np.float64)
+    unit /= np.linalg.norm(unit, axis=1, keepdims=True)
+    triangles = np.asarray(triangles, dtype=np.int64)
+    # The billboards: faces whose first vertex starts a run of six (two triangles each).
+    firsts = faces_of[:, 0].astype(np.int64)
+    starts = np.flatnonzero(firsts % 6 == 0)
+    points, indices, colours = [], [], []
+    for n, face in enumerate(starts):
+        centre, radius = centres[firsts[face]], radii[firsts[face]]
+        points.append(centre + radius * unit)
+        indices.append(triangles + n * len(unit))
+        colours.append(np.repeat(codes[face:face + 1], len(triangles), axis=0))
+    if not points:
+        return pygfx.Geometry(indices=np.zeros((0, 3), np.int32), positions=np.zeros((0, 3), np.float32))
+    return pygfx.Geometry(indices=np.concatenate(indices).astype(np.int32),
+                          positions=np.concatenate(points).astype(np.float32),
+                          colors=pygfx.Buffer(np.ascontiguousarray(np.concatenate(colours), dtype=codes.dtype)))
+
+
 def faces(showm, actors, cam, size, gpu) -> dict:
     """Draw twins of the app's ``actors`` from ``cam`` at ``size``; see :func:`picture.take`."""
     import pygfx
@@ -77,7 +109,15 @@ def faces(showm, actors, cam, size, gpu) -> dict:
         positions = actor.geometry.positions if live else pygfx.Buffer(np.ascontiguousarray(held, np.float32))
         codes = backend._linear(colours[start:start + len(faces_of)])
         start += len(faces_of)
-        geometry = pygfx.Geometry(indices=actor.geometry.indices, positions=positions, colors=pygfx.Buffer(codes))
+        radii = backend.impostor_radii(actor)
+        if radii is not None:
+            # A shader draws each billboard as a sphere: its twin is that sphere, as a fine mesh, in the code
+            # colour of the billboard's first face (the owner of its first vertex).
+            centres = np.asarray(positions.data if live else held, dtype=np.float64)
+            geometry = _spheres(centres, radii / max(np.linalg.norm(np.asarray(actor.world.matrix)[:3, :3], axis=0).max(), 1e-12),
+                                faces_of, codes)
+        else:
+            geometry = pygfx.Geometry(indices=actor.geometry.indices, positions=positions, colors=pygfx.Buffer(codes))
         twin = pygfx.Mesh(geometry, pygfx.MeshBasicMaterial(color_mode="face", side=actor.material.side))
         twin.local.matrix = actor.world.matrix
         twin.visible = backend._visible(actor)

@@ -26,7 +26,7 @@ from scipy.spatial.transform import Rotation
 
 from conformance.tolerances import DEFAULT, Tolerance
 
-__all__ = ["Placement", "bounding_radius", "bounding_sphere", "place", "shape_box"]
+__all__ = ["Placement", "bounding_radius", "bounding_sphere", "distance_to_shapes", "place", "shape_box"]
 
 #: A drawing of another size than the collision shape is not judged, unless a vertex it holds lies further
 #: from the shape's centre than REACH times the shape's radius plus REACH_MARGIN: no decoration of a body
@@ -65,13 +65,60 @@ def bounding_radius(shapes, default: float = 0.05) -> float:
     return max(radii, default=default)
 
 
-def bounding_sphere(shapes) -> tuple[np.ndarray, float]:
+def bounding_sphere(shapes, mesh=()) -> tuple[np.ndarray, float]:
     """Centre (in the link frame) and radius of a sphere around a frame's collision shape: its one box,
-    sphere or cylinder's, else one around the frame's origin."""
+    sphere or cylinder's; else around its collision ``mesh`` vertices (:attr:`~conformance.apps.bodies.Frame.mesh`);
+    else one around the frame's origin."""
     box = shape_box(shapes)
+    if box is None and len(mesh):
+        points = np.asarray(mesh, dtype=np.float64)
+        centre = (points.min(axis=0) + points.max(axis=0)) / 2
+        return centre, float(np.linalg.norm(points - centre, axis=1).max())
     if box is None:
         return np.zeros(3), bounding_radius(shapes)
     return box[0], float(np.linalg.norm(box[1]))
+
+
+def distance_to_shapes(points: np.ndarray, shapes, mesh=()) -> np.ndarray:
+    """How far each of ``points`` ``(m, 3)`` (link-frame coordinates) lies outside a frame's collision
+    shapes, 0 on or inside one: boxes, spheres, cylinders and capsules exactly, mesh shapes by the convex
+    hull of ``mesh`` (pyBullet collides a mesh as its hull unless told otherwise); inf for a frame with
+    none of them (a plane, say)."""
+    points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    best = np.full(len(points), np.inf)
+    for kind, dims, position, orientation in shapes:
+        local = (points - np.asarray(position)) @ Rotation.from_quat(orientation).as_matrix()
+        if kind == "box":
+            outside = np.maximum(np.abs(local) - np.asarray(dims[:3]) / 2, 0.0)
+            distance = np.linalg.norm(outside, axis=1)
+        elif kind == "sphere":
+            distance = np.maximum(np.linalg.norm(local, axis=1) - dims[0], 0.0)
+        elif kind in ("cylinder", "capsule"):
+            height, radius = dims[0], dims[1]
+            radial = np.linalg.norm(local[:, :2], axis=1)
+            if kind == "cylinder":
+                distance = np.hypot(np.maximum(radial - radius, 0.0), np.maximum(np.abs(local[:, 2]) - height / 2, 0.0))
+            else:  # a segment of half length height/2 along z, swept by the radius
+                along = np.clip(local[:, 2], -height / 2, height / 2)
+                distance = np.maximum(np.hypot(radial, local[:, 2] - along) - radius, 0.0)
+        elif kind == "mesh" and len(mesh) >= 4:
+            distance = _outside_hull(points, np.asarray(mesh, dtype=np.float64))
+        else:
+            continue
+        best = np.minimum(best, distance)
+    return best
+
+
+def _outside_hull(points: np.ndarray, vertices: np.ndarray) -> np.ndarray:
+    """How far ``points`` lie outside the convex hull of ``vertices`` (the largest plane distance, 0 inside)."""
+    from scipy.spatial import ConvexHull, QhullError
+
+    try:
+        planes = ConvexHull(vertices).equations
+    except (QhullError, ValueError):  # flat or degenerate: its bounding box
+        low, high = vertices.min(axis=0), vertices.max(axis=0)
+        return np.linalg.norm(np.maximum(np.maximum(low - points, points - high), 0.0), axis=1)
+    return np.maximum((points @ planes[:, :3].T + planes[:, 3]).max(axis=1), 0.0)
 
 
 @dataclass

@@ -37,6 +37,9 @@ class ActorTrack:
     changed: np.ndarray
     announced: np.ndarray
     missed: list = field(default_factory=list)  # (tick, "its normals changed at vertices 0–287, …")
+    #: an actor a shader draws as spheres (FURY 2's impostor spheres): each vertex's sphere radius in world
+    #: units, as first recorded; None for an actor whose triangles are what it draws
+    radii: np.ndarray | None = None
 
 
 @dataclass
@@ -93,6 +96,8 @@ def save(recording: Recording, path) -> None:
         arrays[f"a{i}_announced"] = track.announced
         if track.normals is not None:
             arrays[f"a{i}_normals"] = track.normals
+        if track.radii is not None:
+            arrays[f"a{i}_radii"] = track.radii
         actors.append({"label": track.label, "kind": track.kind, "normals": track.normals is not None,
                        "missed": [list(m) for m in track.missed]})
     meta = {"script": recording.script, "backend": recording.backend, "actors": actors,
@@ -119,7 +124,8 @@ def save(recording: Recording, path) -> None:
 
 def _frame(d: dict) -> Frame:
     shapes = tuple((s[0], tuple(s[1]), tuple(s[2]), tuple(s[3])) for s in d["shapes"])
-    return Frame(d["client"], d["body"], d["link"], d["name"], d["mass"], shapes, tuple(d.get("inertial", (0.0, 0.0, 0.0))))
+    return Frame(d["client"], d["body"], d["link"], d["name"], d["mass"], shapes, tuple(d.get("inertial", (0.0, 0.0, 0.0))),
+                 tuple(tuple(v) for v in d.get("mesh", ())))
 
 
 def load(path) -> Recording:
@@ -135,7 +141,8 @@ def load(path) -> Recording:
             actors.append(ActorTrack(a["label"], a["kind"], data[f"a{i}_vertices"],
                                      data[f"a{i}_normals"] if a["normals"] else None,
                                      data[f"a{i}_changed"], data[f"a{i}_announced"],
-                                     [(int(t), str(text)) for t, text in a.get("missed", [])]))
+                                     [(int(t), str(text)) for t, text in a.get("missed", [])],
+                                     data[f"a{i}_radii"] if f"a{i}_radii" in data else None))
         return Recording(meta["script"], meta["backend"], actors, [_frame(f) for f in meta["frames"]],
                          data["positions"], data["orientations"], data["before_positions"],
                          data["before_orientations"], data["steps"], meta["loop"], meta["ended"],

@@ -8,6 +8,7 @@ one of them). The rest of the kit talks to a backend only through these names:
 * ``build(scene) -> Drawing``: actors for every binding, with each target's reference geometry;
 * ``world_vertices(actor) -> (n, 3)``: what the renderer will draw, in world coordinates;
 * ``world_normals(actor)``: the stored vertex normals as they will be lit, or None;
+* ``impostor_radii(actor)``: each vertex's sphere radius for an actor a shader draws as spheres, or None;
 * ``mesh_signature(actor)``: vertex count, topology and colours, to check a sync keeps the mesh;
 * ``hand_over(actor)``: take its announced changes as a window's next frame would (app mode, after every tick);
 * ``content_state(actor)``: a change counter and a copy of the data, to check changes are announced
@@ -33,7 +34,7 @@ import importlib.metadata
 
 from conformance.errors import BackendError
 
-__all__ = ["ANNOUNCE", "LIGHTING", "MULTISAMPLES", "NAME", "NAMES", "Drawing", "build", "content_state", "content_time", "describe", "flush", "fury_version", "hand_over", "mesh_signature", "perturbed",
+__all__ = ["ANNOUNCE", "LIGHTING", "MULTISAMPLES", "NAME", "NAMES", "Drawing", "build", "content_state", "content_time", "describe", "flush", "fury_version", "hand_over", "impostor_radii", "mesh_signature", "perturbed",
            "render", "render_ids", "renderer_info", "renderer_label", "unannounced", "world_normals", "world_vertices"]
 
 #: Backend names and the FURY each one is: the ``./kit --backend`` values and ``golden/<name>/``.

@@ -169,6 +169,24 @@ def world_normals(actor) -> np.ndarray | None:
     return None if normals is None else turned_normals(normals, _matrix(actor))
 
 
+def impostor_radii(actor) -> np.ndarray | None:
+    """For an actor that draws spheres with a shader (FURY 2's default ``actor.sphere``, ``impostor=True``:
+    a billboard of six vertices at each sphere's centre), each vertex's sphere radius in world units; None
+    for an actor whose triangles are what it draws."""
+    if getattr(actor, "billboard_mode", None) != "impostor":
+        return None
+    radii = getattr(actor, "billboard_radii", None)
+    if radii is None:
+        sizes = np.asarray(getattr(actor, "billboard_sizes", np.zeros((0, 2))), dtype=np.float64)
+        radii = sizes.max(axis=1) / 2 if sizes.size else np.zeros(0)
+    radii = np.asarray(radii, dtype=np.float64).reshape(-1)
+    count = len(_points(actor))
+    if not len(radii) or count % len(radii):
+        return None
+    scale = np.linalg.norm(_matrix(actor)[:3, :3], axis=0).max()  # the shader scales the quad with the actor
+    return np.repeat(radii, count // len(radii)) * scale
+
+
 def _buffers(actor) -> list[tuple[str, object]]:
     geometry = actor.geometry
     return [(name, b) for name in ("positions", "normals") if (b := getattr(geometry, name, None)) is not None]

@@ -135,6 +135,11 @@ def world_normals(actor) -> np.ndarray | None:
     return turned_normals(normals, _matrix(actor))
 
 
+def impostor_radii(actor) -> None:
+    """FURY 0.12's actors draw their triangles: no impostor spheres (see the pygfx backend)."""
+    return None
+
+
 def content_time(actor) -> int:
     """The modification time of the actor's data alone (the first half of :func:`content_state`)."""
     return actor.GetMapper().GetInput().GetMTime()
