@@ -79,3 +79,13 @@ def test_an_impostor_sphere_is_placed_as_the_sphere_it_draws():
     assert all(v.passed for v in right.values()) and not right["placed"].notes, right["placed"].notes
     twice = judge(_impostors(0.2, 0.4), checks=("attached", "placed"))["placed"]
     assert any("not judged: the drawn shape (half extents (0.4, 0.4, 0.4))" in note for note in twice.notes), twice.notes
+
+
+def test_a_note_names_the_ranges_a_frame_holds_not_one_range_over_them():
+    """A frame holding vertices 0-2 and 40-63 of an actor is told as ``0:3, 40:64``: ``0:64`` claimed the
+    vertices between, held by another frame (notes named overlapping ranges of one actor)."""
+    from conformance.apps.judge import _ranges
+
+    assert _ranges(np.array([0, 1, 2, 40, 41, 42])) == "0:3, 40:43"
+    assert _ranges(np.arange(24)) == "0:24"
+    assert _ranges(np.array([0, 2, 4, 6, 8])) == "0:1, 2:3, 4:5 and 2 more ranges"

@@ -385,7 +385,7 @@ class _Judgement:
         verdict = Verdict("placed", True)
         for track, a, frame, rows, result in self.placements():
             info = self.r.frames[frame]
-            where = f"{track.label} vertices {rows[0]}:{rows[-1] + 1} held by {info.label}"
+            where = f"{track.label} vertices {_ranges(rows)} held by {info.label}"
             if not result.judged:
                 verdict.notes.append(f"{where}: {result.why}")
             elif not result.ok:
@@ -487,6 +487,20 @@ class _Judgement:
             verdict.diagnoses.append("written-back")
         verdict.worst = float(change.max())
         return verdict
+
+
+def _ranges(rows: np.ndarray, most: int = 3) -> str:
+    """Sorted vertex indices as the ranges they make: ``0:24``, ``0:3, 40:64``, ``0:3, 8:9, 12:20 and 4
+    more ranges`` (a frame may hold scattered vertices of an actor; one range over them would claim the
+    vertices between)."""
+    rows = np.asarray(rows)
+    if not len(rows):
+        return "none"
+    breaks = np.flatnonzero(np.diff(rows) != 1) + 1
+    starts, stops = np.concatenate([[0], breaks]), np.concatenate([breaks, [len(rows)]])
+    spans = [f"{rows[a]}:{rows[b - 1] + 1}" for a, b in zip(starts, stops)]
+    more = len(spans) - most
+    return ", ".join(spans[:most]) + (f" and {more} more range{'s' if more > 1 else ''}" if more > 0 else "")
 
 
 def _drawn_points(reference: np.ndarray, radii: np.ndarray | None, rows: np.ndarray) -> np.ndarray:
