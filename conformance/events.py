@@ -16,7 +16,7 @@ from typing import Sequence
 
 import pybullet
 
-__all__ = ["Event", "JointReset", "Kick", "Teleport", "dumps", "loads"]
+__all__ = ["LIFT", "Event", "JointReset", "Kick", "Teleport", "dumps", "loads", "turning_everything"]
 
 
 def _bodies(scene) -> list[int]:
@@ -130,3 +130,18 @@ def loads(text: str) -> list[Event]:
         if not all(math.isfinite(v) for v in values):
             raise InvalidArgument(f"event {e!r} has a non-finite value")
     return events
+
+
+#: How far every body is lifted when it is turned again at frame 1 (so that it moves even if its turn does not).
+LIFT = (0.0, 0.0, 0.05)
+
+
+def turning_everything(bodies: int, turns) -> list:
+    """Events turning every one of ``bodies`` bodies, static ones too, and every joint to the orientations
+    ``turns`` (cycled) at frame 0, before the first sync; and turning every body again (``turns``
+    reversed) and lifting it a little at frame 1, after the first sync: a body the sync places once, or
+    only while it has velocity, is then drawn where it was (the orientation check's events)."""
+    again = turns[::-1]
+    events: list = [Teleport(0, i, (0.0, 0.0, 0.0), turns[i % len(turns)]) for i in range(bodies)]
+    events += [JointReset(0, i, 1.0, turns[i % len(turns)]) for i in range(8)]
+    return events + [Teleport(1, i, LIFT, again[i % len(again)]) for i in range(bodies)]

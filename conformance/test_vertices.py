@@ -14,7 +14,7 @@ import pytest
 from hypothesis import example, given, strategies as st
 
 from conformance import backends, compare, figures, profiles, scenes, shared_run, strategies
-from conformance.events import JointReset, Teleport
+from conformance.events import turning_everything
 from conformance.profiles import check_settings
 from conformance.pytest_helpers import _context, bounds_figure, each_scene, reproduce_command
 
@@ -38,21 +38,11 @@ def check_run(kit, scene_name: str, params: dict, frames: int, events=()) -> Non
             kit.assert_frame(run)
 
 
-#: How far every body is lifted when it is turned again at frame 1 (so that it moves even if its turn does not).
-LIFT = (0.0, 0.0, 0.05)
-
-
 def turned_everything(scene_name: str, params: dict, turns) -> list:
-    """Events turning every body, static ones too, and every joint to the orientations ``turns``
-    (cycled) at frame 0, before the first sync; and turning every body again (``turns`` reversed)
-    and lifting it a little at frame 1, after the first sync: a body the sync places once, or
-    only while it has velocity, is then drawn where it was."""
+    """:func:`conformance.events.turning_everything` for every body of the scene built with ``params``."""
     with scenes.build(scene_name, **params) as probe:
         bodies = len({b.body for b in probe.bindings})
-    again = turns[::-1]
-    events = [Teleport(0, i, (0.0, 0.0, 0.0), turns[i % len(turns)]) for i in range(bodies)]
-    events += [JointReset(0, i, 1.0, turns[i % len(turns)]) for i in range(8)]
-    return events + [Teleport(1, i, LIFT, again[i % len(again)]) for i in range(bodies)]
+    return turning_everything(bodies, turns)
 
 
 def with_scene_examples(scene_name: str, **fixed):

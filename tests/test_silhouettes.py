@@ -64,6 +64,7 @@ def check(run, camera=None):
     fury, bullet = masks(run, camera)
     return silhouettes.compare_silhouettes(fury, bullet, min_iou=silhouettes.thresholds(run.scene.bindings),
                                            rounding=silhouettes.roundings(run.scene.bindings),
+                                           discs=silhouettes.projected_discs(run.scene, run.scene.bindings, run.scene.camera, run.scene.image_size),
                                            names=[t.name for t in run.drawing.targets], scene=run.scene.name,
                                            frame=run.frame,
                                            touching=silhouettes.touching_pairs(run.scene, run.scene.bindings, fury, bullet))
@@ -319,3 +320,25 @@ def test_a_sphere_large_on_screen_drawn_right_passes():
     with runner.running("free_fall", REFERENCE, kind="sphere", size=1.0) as run:
         record = check(run)
         assert record.passed and record.details["targets"][0]["fury_pixels"] > 20000, record.message
+
+
+def test_a_sphere_hidden_but_for_a_rim_is_judged_against_where_physics_has_it():
+    """A ball 24 px in radius behind a wall shows a 2-px rim past the wall's edge in FURY's picture and
+    none in pyBullet's (its coarser sphere does not reach past the edge): measured, the wrecking ball's
+    ball behind its turned ground plate, 14 pixels off with a 3 px slack. Inside the disc physics puts
+    the ball in, FURY's pixels are the ball's; a rim outside that disc still counts."""
+    size = (120, 120)
+    wall = np.full(size, -1)
+    wall[:, 38:] = 1  # a wall in front of the ball, from column 38 on
+    fury, bullet = _disc(size, (60, 60), 24, 0, wall), _disc(size, (60, 60), 22, 0, wall)  # pyBullet's coarser
+    fury[wall == 1], bullet[wall == 1] = 1, 1
+    fury, bullet = _disc(size, (60, 60), 10, 0, fury), _disc(size, (60, 60), 10, 0, bullet)  # where it pokes through
+    # FURY's rim past the wall's edge (columns 36-37) lies 20 px from any ball pixel pyBullet shows
+    rounding = [silhouettes.ROUNDING["sphere"], None]
+    assert not silhouettes.compare_silhouettes(fury, bullet, min_iou=0.98, rounding=rounding).passed
+    disc = [(60.0, 60.0, 24.0), None]
+    record = silhouettes.compare_silhouettes(fury, bullet, min_iou=0.98, rounding=rounding, discs=disc)
+    assert record.passed, record.message
+    elsewhere = fury.copy()
+    elsewhere[10:20, 30:42] = 0  # drawn beyond the disc: counts
+    assert not silhouettes.compare_silhouettes(elsewhere, bullet, min_iou=0.98, rounding=rounding, discs=disc).passed

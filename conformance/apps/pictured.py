@@ -34,6 +34,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from conformance.rendering import silhouettes
 
@@ -164,6 +165,33 @@ def edges_only(fury: np.ndarray, bullet: np.ndarray, slack: int = silhouettes.SL
     return np.isin(fury, thin) | np.isin(bullet, thin)
 
 
+def _discs(shot: dict, recording, rounding) -> list:
+    """Where each sphere frame is in the picture at the shot's tick, as physics has it (column, row, radius
+    in pixels: :func:`conformance.rendering.silhouettes.projected_discs`, from the recorded poses)."""
+    from conformance.apps.picture import Camera
+    from conformance.rendering import projection
+
+    spheres = [i for i, kind in enumerate(rounding) if kind is not None]
+    found = [None] * len(recording.frames)
+    tick = int(shot["tick"])
+    if not spheres or not 0 <= tick < len(recording.positions) or not shot.get("camera"):
+        return found
+    camera = Camera(**{k: tuple(v) if isinstance(v, list) else v for k, v in shot["camera"].items()})
+    size = tuple(shot["size"])
+    centres, radii = [], []
+    for i in spheres:
+        kind, dims, position, orientation = recording.frames[i].shapes[0]
+        turn = Rotation.from_quat(recording.orientations[tick, i])
+        centres.append(turn.apply(position) + recording.positions[tick, i])
+        radii.append(float(dims[0]))
+    pixels, depth = projection.project(camera, size, np.array(centres))
+    per_metre = size[1] / 2 / np.tan(np.radians(camera.view_angle) / 2)
+    for i, (column, row), d, radius in zip(spheres, pixels, depth, radii):
+        if d > 0:
+            found[i] = (float(column), float(row), radius * per_metre / float(d))
+    return found
+
+
 def _diagnosis(frame: int, shot: dict, recording, attachments) -> str:
     """``hidden`` when the actors drawing ``frame`` are hidden or mostly too faint; ``stale-gpu`` when the
     GPU holds some of its vertices elsewhere than their arrays; else none."""
@@ -215,7 +243,7 @@ def check(judgement):
             fury[rims], bullet[rims] = -1, -1
         touching = {tuple(p) for p in shot.get("touching", [])}
         record = silhouettes.compare_silhouettes(fury, bullet, min_iou=limits, rounding=rounding, names=names,
-                                                 scene=f"app-{Path(r.script).stem}",
+                                                 discs=_discs(shot, r, rounding), scene=f"app-{Path(r.script).stem}",
                                                  frame=int(shot["tick"]), touching=touching)
         record.sync = "app"
         record.params = {"events": r.events}

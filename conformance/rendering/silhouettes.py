@@ -51,7 +51,7 @@ from . import projection
 from .records import ImageCheck
 
 __all__ = ["LEAST_OFF", "MIN_IOU", "MIN_PIXELS", "ROUNDING", "SLACK", "TOUCHING", "compare_silhouettes", "mask_images",
-           "pybullet_mask", "rounded_slacks", "roundings", "thresholds", "touching_pairs"]
+           "projected_discs", "pybullet_mask", "rounded_slacks", "roundings", "thresholds", "touching_pairs"]
 
 #: A target is judged only where it covers at least this many pixels in either mask: below that its
 #: IoU is dominated by which edge pixels each rasteriser keeps.
@@ -125,16 +125,27 @@ def _near(mask: np.ndarray, slack: int) -> np.ndarray:
     return ndimage.binary_dilation(mask, np.ones((2 * slack + 1, 2 * slack + 1), dtype=bool))
 
 
-def rounded_slacks(pixels: int, rounding: tuple[float, float] | None, slack: int = SLACK) -> tuple[int, int]:
+def _in_disc(disc, shape, slack: int) -> np.ndarray:
+    """The pixels (``shape`` = rows, columns) whose centres lie within a disc (column, row, radius in
+    pixels) grown by ``slack``; none for no disc."""
+    if disc is None:
+        return np.zeros(shape, dtype=bool)
+    column, row, radius = disc
+    rows, columns = np.ogrid[:shape[0], :shape[1]]
+    return (columns + 0.5 - column) ** 2 + (rows + 0.5 - row) ** 2 <= (radius + slack) ** 2
+
+
+def rounded_slacks(pixels: int, rounding: tuple[float, float] | None, slack: int = SLACK,
+                   radius: float | None = None) -> tuple[int, int]:
     """``(fury_only, pybullet_only)``: how many pixels from the other mask a pixel only in FURY's, only in
     pyBullet's, mask of a target may lie and be put down to the edge, for a target covering ``pixels``
     pixels. For a sphere (``rounding`` = the two renderers' :data:`ROUNDING`) each renderer's outline may
-    lie inside the true one by its tessellation's depth, a fraction of the radius on screen (taken as
-    that of a disc of ``pixels`` pixels): pixels only FURY draws are explained up to pyBullet's depth,
-    pixels only pyBullet draws up to FURY's."""
+    lie inside the true one by its tessellation's depth, a fraction of its ``radius`` on screen (in
+    pixels; by default that of a disc of ``pixels`` pixels, too small for a sphere partly hidden): pixels
+    only FURY draws are explained up to pyBullet's depth, pixels only pyBullet draws up to FURY's."""
     if rounding is None:
         return slack, slack
-    radius = math.sqrt(pixels / math.pi)
+    radius = max(math.sqrt(pixels / math.pi), radius or 0.0)
     fury, bullet = rounding
     return slack + math.ceil(bullet * radius), slack + math.ceil(fury * radius)
 
@@ -158,6 +169,7 @@ def compare_silhouettes(ids_fury: np.ndarray, ids_pybullet: np.ndarray, *, min_p
                         min_iou=0.95, slack: int = SLACK, names: Sequence[str] = (), scene: str = "",
                         frame: int = 0, touching: set[tuple[int, int]] | None = None,
                         rounding: Sequence[tuple[float, float] | None] | None = None,
+                        discs: Sequence[tuple[float, float, float] | None] | None = None,
                         least_off: int = LEAST_OFF) -> ImageCheck:
     """Per target, how well FURY's silhouette and pyBullet's agree, for every target covering at least
     ``min_pixels`` pixels in either mask; passes when each such target's IoU is at least its ``min_iou``
@@ -171,12 +183,18 @@ def compare_silhouettes(ids_fury: np.ndarray, ids_pybullet: np.ndarray, *, min_p
     more than ``slack`` pixels from the other mask, so ``iou = 1 - off / union`` (``slack=0``: the plain
     intersection over union, also reported per target as ``plain_iou``). A target with a ``rounding``
     (:func:`roundings`: a sphere) has the slack of :func:`rounded_slacks` instead, and so do the pixels
-    where its outline meets another target. ``names`` name the targets."""
+    where its outline meets another target. ``discs`` are where the spheres are on screen, as physics
+    has them (:func:`projected_discs`: column, row and radius in pixels): a pixel FURY draws of a sphere
+    inside its disc (grown by the slack) is the sphere's, however little of pyBullet's coarser sphere
+    shows near it (a sphere hidden but for a rim past another body's edge). ``names`` name the targets."""
     if ids_fury.shape != ids_pybullet.shape:
         raise ValueError(f"mask shapes differ: {ids_fury.shape} vs {ids_pybullet.shape}")
     count = int(max(ids_fury.max(initial=-1), ids_pybullet.max(initial=-1), len(names) - 1)) + 1
     rounding = list(rounding) if rounding is not None else []
     rounding += [None] * (count - len(rounding))
+    discs = list(discs) if discs is not None else []
+    discs += [None] * (count - len(discs))
+    radii = [d[2] if d is not None else None for d in discs]
     # Where two bodies touch or interpenetrate, which one is in front depends on each renderer's
     # tessellation and depth test (measured: a cylinder cut by a turned ground, 13 FURY pixels against
     # 68 pyBullet pixels, 1 draw in 300 of the orientation property, with the reference sync). Pixels
@@ -195,8 +213,8 @@ def compare_silhouettes(ids_fury: np.ndarray, ids_pybullet: np.ndarray, *, min_p
         for k in set(np.unique(np.concatenate([ids_fury[differ], ids_pybullet[differ]])).tolist()):
             if rounding[k] is None:
                 continue
-            fury_only, bullet_only = rounded_slacks(int(max(fury[k], bullet[k])), rounding[k], slack)
-            contested |= differ & (((ids_fury == k) & _near(ids_pybullet == k, fury_only))
+            fury_only, bullet_only = rounded_slacks(int(max(fury[k], bullet[k])), rounding[k], slack, radii[k])
+            contested |= differ & (((ids_fury == k) & (_near(ids_pybullet == k, fury_only) | _in_disc(discs[k], ids_fury.shape, slack)))
                                    | ((ids_pybullet == k) & _near(ids_fury == k, bullet_only)))
     fury_ids = np.where(contested, -1, ids_fury)
     bullet_ids = np.where(contested, -1, ids_pybullet)
@@ -207,13 +225,18 @@ def compare_silhouettes(ids_fury: np.ndarray, ids_pybullet: np.ndarray, *, min_p
     targets = []
     for i in np.flatnonzero(np.maximum(fury, bullet) >= min_pixels):
         a, b = fury_ids == i, bullet_ids == i
-        fury_only, bullet_only = rounded_slacks(int(max(fury[i], bullet[i])), rounding[i], slack)
+        fury_only, bullet_only = rounded_slacks(int(max(fury[i], bullet[i])), rounding[i], slack, radii[i])
         grow = max(fury_only, bullet_only)
         rows, cols = np.nonzero(a | b)  # work on the target's box, grown by the slack, not the whole picture
         box = (slice(max(rows.min() - grow, 0), rows.max() + grow + 1),
                slice(max(cols.min() - grow, 0), cols.max() + grow + 1))
         union = int(fury[i] + bullet[i] - both[i])
-        off = _far_mismatch(a[box], b[box], fury_only, bullet_only)
+        if discs[i] is None:
+            off = _far_mismatch(a[box], b[box], fury_only, bullet_only)
+        else:  # FURY's pixels inside the sphere's disc are right wherever pyBullet's coarse sphere shows
+            inside = _in_disc(discs[i], ids_fury.shape, slack)[box]
+            off = int(np.count_nonzero(a[box] & ~_near(b[box], fury_only) & ~inside)
+                      + np.count_nonzero(b[box] & ~_near(a[box], bullet_only)))
         targets.append({"target": names[i] if i < len(names) else f"#{i}", "index": int(i),
                         "iou": 1.0 - off / union, "plain_iou": float(both[i] / union), "off": off,
                         "allowed_off": max(least_off, int((1.0 - limits[i]) * union)),
@@ -250,6 +273,26 @@ def compare_silhouettes(ids_fury: np.ndarray, ids_pybullet: np.ndarray, *, min_p
 def thresholds(bindings: Sequence) -> list[float]:
     """Each binding's ``min_iou``, by the kind of its shape (:data:`MIN_IOU`)."""
     return [MIN_IOU[b.shape.kind] for b in bindings]
+
+
+def projected_discs(scene, bindings: Sequence, camera, size) -> list[tuple[float, float, float] | None]:
+    """Where each sphere binding is on screen now, as physics has it: ``(column, row, radius)`` in pixels
+    (its centre projected, its radius at its depth); None for other shapes and a sphere behind the camera."""
+    from conformance import poses, truth
+
+    spheres = [i for i, b in enumerate(bindings) if b.shape.kind == "sphere"]
+    found: list[tuple[float, float, float] | None] = [None] * len(bindings)
+    if not spheres:
+        return found
+    positions, orientations = truth.link_frames(scene.p, [(bindings[i].body, bindings[i].link) for i in spheres])
+    centres = np.array([poses.apply(pos, orn, [bindings[i].shape.position])[0]
+                        for i, pos, orn in zip(spheres, positions, orientations)])
+    pixels, depth = projection.project(camera, size, centres)
+    per_metre = size[1] / 2 / math.tan(math.radians(camera.view_angle) / 2)
+    for i, (column, row), d in zip(spheres, pixels, depth):
+        if d > 0:
+            found[i] = (float(column), float(row), float(bindings[i].shape.size[0] * per_metre / d))
+    return found
 
 
 def roundings(bindings: Sequence) -> list[tuple[float, float] | None]:
