@@ -126,6 +126,13 @@ def sync_draws(specs, seeds, *, factor: int, jobs: int | None = None, timeout: f
         return [f.result() for f in futures]
 
 
+def _per_spec(draws) -> str:
+    counts: dict[str, int] = {}
+    for d in draws:
+        counts[d.spec] = counts.get(d.spec, 0) + 1
+    return ", ".join(f"`{spec}` {n} seed{'s' if n != 1 else ''}" for spec, n in counts.items())
+
+
 def app_draws(paths, seeds, *, runs: int, jobs: int | None = None, timeout: float | None = None) -> list[AppDraw]:
     """Every right app of ``paths``: its own run, then ``runs`` perturbed runs drawn from each seed."""
     from concurrent.futures import ThreadPoolExecutor, as_completed
@@ -202,8 +209,8 @@ def markdown(syncs: list[SyncDraw], app_runs: list[AppDraw], *, made_by: str, ba
                                   f"replay: `{rerun_command(draw.spec, draw.seed, draw.factor, record['nodeid'])}`")
         broken = [d for d in syncs if d.broken]
         total = sum(failed.values())
-        lines += [f"**Syncs**: {len(specs)} right ({', '.join(f'`{s}`' for s in specs)}), {len(syncs)} processes "
-                  f"({len(syncs) // max(len(specs), 1)} seeds each, {syncs[0].factor}x the default profile's examples each), "
+        lines += [f"**Syncs**: {len(specs)} right, {len(syncs)} processes ({_per_spec(syncs)}; each "
+                  f"{syncs[0].factor}x the default profile's examples), "
                   f"{seconds / 60:.1f} CPU-minutes of processes: **{total} false alarm{'s' if total != 1 else ''}** "
                   f"in {sum(runs.values())} default-profile runs of {len(runs)} checks.", ""]
         if broken:

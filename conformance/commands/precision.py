@@ -21,6 +21,11 @@ def add_arguments(parser) -> None:
                         help="right apps to run, their own run and --app-runs perturbed runs from each seed (repeatable)")
     parser.add_argument("--seeds", type=argparse_type(positive_int, "--seeds", high=1_000_000), default=10,
                         help="processes per sync (seeds first-seed, first-seed+1, …; default 10)")
+    parser.add_argument("--right-seeds", type=argparse_type(positive_int, "--right-seeds", high=1_000_000), default=None,
+                        metavar="M", help="processes per sync of the --right modules (default: --seeds): the named syncs "
+                        "get the most draws")
+    parser.add_argument("--app-seeds", type=argparse_type(positive_int, "--app-seeds", high=1_000_000), default=None,
+                        metavar="M", help="seeds per app (default: --seeds)")
     parser.add_argument("--first-seed", type=argparse_type(whole_number, "--first-seed"), default=1, metavar="S")
     parser.add_argument("--factor", type=argparse_type(positive_int, "--factor", high=100_000), default=10,
                         help="default-profile runs of each check one process stands for (its examples are this "
@@ -40,9 +45,9 @@ def run(args, extra) -> int:
 
     from conformance import backends, precision, sync, verdicts
 
-    specs = list(args.specs) + [spec for module in args.right for spec in verdicts.implementations(module)]
-    if not specs and not args.apps:
-        specs = ["reference"]
+    named = list(args.specs) or ([] if args.apps or args.right else ["reference"])
+    others = [spec for module in args.right for spec in verdicts.implementations(module) if spec not in named]
+    specs = named + others
     for spec in specs:  # a spec that cannot load fails now, in one paragraph
         sync.load(spec)
     paths = sorted({path for pattern in args.apps for path in glob.glob(pattern)})
@@ -50,13 +55,19 @@ def run(args, extra) -> int:
     if missing:
         print(f"error: --apps {', '.join(map(repr, missing))} matched no file", file=sys.stderr)
         return 2
-    seeds = list(range(args.first_seed, args.first_seed + args.seeds))
-    syncs = precision.sync_draws(specs, seeds, factor=args.factor, jobs=args.jobs, timeout=args.timeout) if specs else []
-    app_runs = precision.app_draws(paths, seeds, runs=args.app_runs, jobs=args.jobs, timeout=args.timeout) if paths else []
+    def seeds(count):
+        return list(range(args.first_seed, args.first_seed + (count or args.seeds)))
+
+    syncs = precision.sync_draws(named, seeds(args.seeds), factor=args.factor, jobs=args.jobs, timeout=args.timeout)
+    syncs += precision.sync_draws(others, seeds(args.right_seeds), factor=args.factor, jobs=args.jobs, timeout=args.timeout)
+    app_runs = precision.app_draws(paths, seeds(args.app_seeds), runs=args.app_runs, jobs=args.jobs,
+                                   timeout=args.timeout) if paths else []
     made_by = shlex.join(["python", "-m", "conformance", "precision", *args.specs,
                           *[part for module in args.right for part in ("--right", module)],
                           *[part for pattern in args.apps for part in ("--apps", pattern)],
-                          "--seeds", str(args.seeds), "--first-seed", str(args.first_seed), "--factor", str(args.factor),
+                          "--seeds", str(args.seeds), *(["--right-seeds", str(args.right_seeds)] if args.right_seeds else []),
+                          *(["--app-seeds", str(args.app_seeds)] if args.app_seeds else []),
+                          "--first-seed", str(args.first_seed), "--factor", str(args.factor),
                           *(["--app-runs", str(args.app_runs)] if paths else [])])
     emit(precision.markdown(syncs, app_runs, made_by=made_by, backend=backends.describe()), args.out)
     alarms = any(d.false_alarms or d.broken for d in syncs) or any(d.failed or d.error for d in app_runs)
