@@ -89,3 +89,25 @@ def test_a_note_names_the_ranges_a_frame_holds_not_one_range_over_them():
     assert _ranges(np.array([0, 1, 2, 40, 41, 42])) == "0:3, 40:43"
     assert _ranges(np.arange(24)) == "0:24"
     assert _ranges(np.array([0, 2, 4, 6, 8])) == "0:1, 2:3, 4:5 and 2 more ranges"
+
+
+def test_every_note_is_shown_on_asking(tmp_path):
+    """``app --notes all`` prints every note of every check; by default a check's notes past three are
+    counted, and the count says how to see them (before, '… 26 more notes' and nothing showed them)."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    from conformance import backends
+
+    app = Path(__file__).resolve().parent.parent / "examples" / backends.NAME / "r2d2.py"
+
+    def run(*extra):
+        done = subprocess.run([sys.executable, "-m", "conformance", "app", str(app), "--ticks", "10", "--perturbed", "0",
+                               "--results", str(tmp_path), *extra], capture_output=True, text=True, timeout=600)
+        assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
+        return done.stdout
+
+    short, everything = run("--notes", "1"), run("--notes", "all")
+    assert "more notes (--notes all shows them)" in short and "more notes" not in everything
+    assert everything.count("note: ") > short.count("note: ")

@@ -1,4 +1,4 @@
-"""``app PATH.py [PATH.py …] [--ticks N] [--perturbed K] [--events JSON] [--tick NAME]``: check your own
+"""``app PATH.py [PATH.py …] [--ticks N] [--perturbed K] [--seed S] [--events JSON] [--tick NAME] [--notes N|all]``: check your own
 program, unmodified: the kit runs it headless, drives its own per-frame callback, and judges what its
 actors draw against every body pyBullet simulates (no mapping needed; see conformance.apps)."""
 
@@ -24,6 +24,8 @@ def add_arguments(parser) -> None:
     parser.add_argument("--tick", default=None, metavar="NAME", help="a module-level function of the app to call once "
                         "a tick, for an app whose loop is its own")
     parser.add_argument("--timeout", default="300", metavar="S", help="seconds one run of the app may take (default 300)")
+    parser.add_argument("--notes", default=str(NOTES), metavar="N|all", help=f"notes printed under each check "
+                        f"(default {NOTES}; 'all' for every one)")
     parser.add_argument("--results", default=None, metavar="DIR", help="where a failing picture check writes its "
                         "pictures and their records (default: the scene checks' results directory, conformance-results)")
 
@@ -32,7 +34,7 @@ def add_arguments(parser) -> None:
 NOTES = 3
 
 
-def _print_result(result, label: str, results=None) -> None:
+def _print_result(result, label: str, results=None, notes: int | None = NOTES) -> None:
     r = result.recording
     steps = sorted(set(int(s) for s in r.steps[1:])) or [0]
     print(f"{label}: {r.ticks} ticks ({'/'.join(map(str, steps))} step(s) per tick); {r.ended}")
@@ -44,10 +46,11 @@ def _print_result(result, label: str, results=None) -> None:
         if len(verdict.lines) > 12:
             print(f"      … {len(verdict.lines) - 12} more lines")
         # What the check could not decide, or left out, is part of its verdict (a pass that judged nothing says so).
-        for note in dict.fromkeys(verdict.notes[:NOTES]):
+        unique = list(dict.fromkeys(verdict.notes))
+        for note in unique[:notes]:
             print(f"      note: {note}")
-        if len(verdict.notes) > NOTES:
-            print(f"      … {len(verdict.notes) - NOTES} more notes")
+        if notes is not None and len(unique) > notes:
+            print(f"      … {len(unique) - notes} more notes (--notes all shows them)")
         if check == "pictured" and results is not None and not verdict.passed:  # nothing written for a pass
             from conformance.apps import pictured
 
@@ -68,6 +71,7 @@ def run(args, extra) -> int:
     runs = validation.whole_number("--perturbed", args.perturbed, low=0, high=1000)
     timeout = validation.finite_non_negative("--timeout", args.timeout)
     seed = None if args.seed is None else validation.whole_number("--seed", args.seed)
+    notes = None if str(args.notes).strip() == "all" else validation.whole_number("--notes", args.notes)
     events = None
     if args.events is not None:
         from conformance.apps import perturb
@@ -86,7 +90,7 @@ def run(args, extra) -> int:
             failed += 1
             continue
         print(f"  loop: {result.recording.loop}")
-        _print_result(result, "own run" if not events else "run with the given events", results)
+        _print_result(result, "own run" if not events else "run with the given events", results, notes)
         ok = result.passed
         if ok and events is None and runs:
             found = perturbed.search(path, examples=runs, tick_function=args.tick, timeout=timeout, seed=seed)
@@ -95,7 +99,7 @@ def run(args, extra) -> int:
                 print(f"  PASS perturbed: {runs} runs of {apps.PERTURBED_TICKS} ticks with the kit's teleports, kicks and joint resets{drawn}")
             else:
                 ok = False
-                _print_result(found, f"perturbed run (events {json.dumps(found.events)}; not shrunk)", results)
+                _print_result(found, f"perturbed run (events {json.dumps(found.events)}; not shrunk)", results, notes)
         failed += not ok
         print(f"verdict: {'PASS' if ok else 'FAIL'} {path}")
     return 1 if failed else 0
