@@ -38,6 +38,8 @@ SYNC_OPTION = "--sync"
 _SYNC_KEY = pytest.StashKey["object"]()
 _VERDICT_KEY = pytest.StashKey[dict]()
 _RECORDS_KEY = pytest.StashKey[list]()
+#: How many checks of each scene the session selected (not known in pytest-xdist's controller, which collects nothing).
+_SELECTED_KEY = pytest.StashKey[dict]()
 #: The name under which each check's record rides on its report (``report.user_properties``).
 _RECORD_PROPERTY = "conformance_record"
 
@@ -486,6 +488,47 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus) -> None:
     write_atomically(path, json.dumps(payload, indent=1, default=float).encode("utf-8"))  # never half a report
 
 
+def pytest_collection_finish(session: pytest.Session) -> None:
+    if not session.items:
+        return
+    counts: dict[str, int] = defaultdict(int)
+    for item in session.items:
+        marker = item.get_closest_marker("scene")
+        if marker is not None:
+            counts[marker.args[0]] += 1
+    session.config.stash[_SELECTED_KEY] = dict(counts)
+    if hasattr(session.config, "workeroutput"):  # for the pytest-xdist controller, which prints the verdicts
+        session.config.workeroutput["conformance_selected"] = dict(counts)
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_testnodedown(node, error) -> None:
+    """pytest-xdist's controller: what each worker selected (every worker collects every check; a crashed
+    one's replacement collects again), so that a scene not fully run is never called PASS."""
+    counts = getattr(node, "workeroutput", {}).get("conformance_selected")
+    if counts:
+        kept = node.config.stash.setdefault(_SELECTED_KEY, {})
+        for scene, count in counts.items():
+            kept[scene] = max(kept.get(scene, 0), count)
+
+
+def _scene_verdict(outcomes: dict, selected: int | None, stopped: bool) -> tuple[str, str]:
+    """A scene's verdict word and its counts: FAIL if a check failed; PASS only when every check of it that
+    the session selected ran and passed; INCOMPLETE when some did not run (the run was interrupted, or -x
+    stopped it), NOT RUN when none did."""
+    failed, passed, skipped = (len(set(outcomes.get(k, []))) for k in ("failed", "passed", "skipped"))
+    ran = len({nodeid for nodeids in outcomes.values() for nodeid in nodeids})
+    detail = f"{passed} passed" + (f", {failed} failed" if failed else "") + (f", {skipped} skipped" if skipped else "")
+    if failed:
+        missing = (selected - ran) if selected is not None and selected > ran else 0
+        return "FAIL", detail + (f"; {missing} of its {selected} checks not run" if missing else "")
+    if selected is not None and ran < selected:
+        return ("INCOMPLETE" if ran else "NOT RUN"), (detail + "; " if ran else "") + f"{selected - ran} of its {selected} checks not run"
+    if selected is None and stopped:
+        return "INCOMPLETE", detail + "; the run stopped before every check ran"
+    return ("PASS" if passed else "SKIP"), detail
+
+
 def pytest_terminal_summary(terminalreporter, exitstatus, config: pytest.Config) -> None:
     from conformance import image_options
 
@@ -497,11 +540,14 @@ def pytest_terminal_summary(terminalreporter, exitstatus, config: pytest.Config)
     from conformance import backends
 
     tr.section(f"conformance verdict per scene (sync {_sync_spec(config)!r}, {backends.NAME} backend)")
-    width = max(len(name) for name in verdicts)
-    for scene, outcomes in verdicts.items():
-        failed = len(outcomes.get("failed", []))
-        passed = len(outcomes.get("passed", []))
-        skipped = len(outcomes.get("skipped", []))
-        verdict = "FAIL" if failed else ("PASS" if passed else "SKIP")
-        detail = f"{passed} passed" + (f", {failed} failed" if failed else "") + (f", {skipped} skipped" if skipped else "")
-        tr.write_line(f"{verdict:4}  {scene:<{width}}  {detail}", red=bool(failed), green=not failed and bool(passed))
+    selected = config.stash.get(_SELECTED_KEY, None)
+    session = getattr(tr, "_session", None)
+    stopped = exitstatus == pytest.ExitCode.INTERRUPTED or bool(session is not None and (session.shouldstop or session.shouldfail))
+    scenes = list(verdicts) + [scene for scene in (selected or {}) if scene not in verdicts]
+    width = max(len(name) for name in scenes)
+    words = max(len(_scene_verdict(verdicts.get(s, {}), (selected or {}).get(s) if selected is not None else None, stopped)[0])
+                for s in scenes)
+    for scene in scenes:
+        verdict, detail = _scene_verdict(verdicts.get(scene, {}), selected.get(scene) if selected is not None else None, stopped)
+        tr.write_line(f"{verdict:{max(words, 4)}}  {scene:<{width}}  {detail}", red=verdict == "FAIL",
+                      yellow=verdict in ("INCOMPLETE", "NOT RUN"), green=verdict == "PASS")

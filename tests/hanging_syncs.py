@@ -33,3 +33,11 @@ class HangsOnFreeFall(MisbehavesOnFreeFall):
             time.sleep(3600)
         except Exception:
             pass
+
+
+class InterruptedOnFreeFall(MisbehavesOnFreeFall):
+    """Raises KeyboardInterrupt at that call, as Ctrl-C pressed while a sync runs: the run ends part-way
+    (``tests/test_scene_verdicts.py``)."""
+
+    def misbehave(self):
+        raise KeyboardInterrupt
