@@ -23,7 +23,7 @@ import shlex
 import time
 from dataclasses import dataclass, field
 
-__all__ = ["SEED_VARIABLE", "AppDraw", "SyncDraw", "app_draws", "draw_seed", "markdown", "rerun_command", "sync_draws"]
+__all__ = ["SEED_VARIABLE", "AppDraw", "Journal", "SyncDraw", "app_draws", "draw_seed", "markdown", "rerun_command", "sync_draws"]
 
 #: The environment variable that fixes :func:`draw_seed` (to replay a slice CI drew).
 SEED_VARIABLE = "KIT_DRAW_SEED"
@@ -89,6 +89,80 @@ class AppDraw:
     error: str = ""
 
 
+class Journal:
+    """The draws made so far, one JSON line each, appended as each finishes (``precision --journal``): a
+    run of hours can be stopped and started again, and goes on from where it was; the tables are made
+    from every draw the journal holds."""
+
+    _KEEP = ("nodeid", "check", "scene", "outcome", "message", "figures")
+
+    def __init__(self, path):
+        import json
+        from pathlib import Path
+
+        self.path = Path(path)
+        self.made: dict[tuple, SyncDraw | AppDraw] = {}
+        if self.path.exists():
+            for number, line in enumerate(self.path.read_text(encoding="utf-8").splitlines(), 1):
+                if not line.strip():
+                    continue
+                try:
+                    entry = json.loads(line)
+                    draw = SyncDraw(**entry["draw"]) if entry["kind"] == "sync" else AppDraw(**entry["draw"])
+                except (ValueError, KeyError, TypeError):
+                    continue  # a line cut short by a kill: that draw is made again
+                self.made[self.key(draw)] = draw
+
+    @staticmethod
+    def key(draw) -> tuple:
+        if isinstance(draw, SyncDraw):
+            return ("sync", draw.spec, draw.seed, draw.factor)
+        return ("app", draw.app, draw.seed, draw.runs)
+
+    def add(self, draw) -> None:
+        import dataclasses
+        import json
+        import os
+
+        entry = dataclasses.asdict(draw)
+        if isinstance(draw, SyncDraw):
+            entry["records"] = [{k: r.get(k) for k in self._KEEP} for r in draw.records]
+            entry["stderr"] = draw.stderr[-1500:]
+        line = json.dumps({"kind": "sync" if isinstance(draw, SyncDraw) else "app", "draw": entry}, default=float) + "\n"
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        if self.path.exists() and self.path.stat().st_size:
+            with open(self.path, "rb") as seen:
+                seen.seek(-1, os.SEEK_END)
+                if seen.read(1) != b"\n":  # the last line was cut short by a kill: start a line of our own
+                    line = "\n" + line
+        with open(self.path, "a", encoding="utf-8") as out:  # one write a line: a kill loses at most the line
+            out.write(line)
+            out.flush()
+            os.fsync(out.fileno())
+        self.made[self.key(draw)] = draw
+
+
+def _run_all(todo, make, journal, jobs, what):
+    """``make(item)`` for every item not in ``journal`` yet, ``jobs`` at a time; the journal's draws for the rest."""
+    from concurrent.futures import ThreadPoolExecutor, as_completed
+
+    from conformance.progress import progress
+
+    results = {}
+    with ThreadPoolExecutor(max_workers=jobs or 1) as pool:
+        futures = {}
+        for key, item in todo:
+            if journal is not None and key in journal.made:
+                results[key] = journal.made[key]
+            else:
+                futures[pool.submit(make, item)] = key
+        for future in progress(as_completed(futures), total=len(futures), what=what):
+            results[futures[future]] = future.result()
+            if journal is not None:
+                journal.add(results[futures[future]])
+    return [results[key] for key, _ in todo]
+
+
 def pytest_args(seed: int) -> list[str]:
     """What each process adds to :func:`conformance.verdicts.command`: the drawing checks, the precision profile, the seed."""
     return ["-m", "draws", "--hypothesis-profile", "precision", f"--hypothesis-seed={seed}"]
@@ -103,27 +177,25 @@ def rerun_command(spec: str, seed: int, factor: int, nodeid: str = "") -> str:
                                                     *pytest_args(seed), *select])
 
 
-def sync_draws(specs, seeds, *, factor: int, jobs: int | None = None, timeout: float | None = None) -> list[SyncDraw]:
-    """Every right sync of ``specs`` through the drawing checks once per seed, ``jobs`` processes at a time."""
+def sync_draws(specs, seeds, *, factor: int, jobs: int | None = None, timeout: float | None = None,
+               journal: Journal | None = None) -> list[SyncDraw]:
+    """Every right sync of ``specs`` through the drawing checks once per seed, ``jobs`` processes at a time
+    (those the ``journal`` holds already are not made again)."""
     import os
-    from concurrent.futures import ThreadPoolExecutor, as_completed
 
     from conformance import verdicts
     from conformance.profiles import DRAW_FACTOR
-    from conformance.progress import progress
 
     env = {**os.environ, DRAW_FACTOR: str(factor)}
 
-    def one(spec: str, seed: int) -> SyncDraw:
+    def one(item) -> SyncDraw:
+        spec, seed = item
         start = time.monotonic()
         outcome = verdicts.check(spec, pytest_args=pytest_args(seed), env=env, timeout=timeout)
         return SyncDraw(spec, seed, factor, time.monotonic() - start, outcome.exitstatus, outcome.records, outcome.stderr)
 
-    with ThreadPoolExecutor(max_workers=jobs or 1) as pool:
-        futures = [pool.submit(one, spec, seed) for spec in specs for seed in seeds]
-        for _ in progress(as_completed(futures), total=len(futures), what="draws made"):
-            pass
-        return [f.result() for f in futures]
+    todo = [(("sync", spec, seed, factor), (spec, seed)) for spec in specs for seed in seeds]
+    return _run_all(todo, one, journal, jobs, "draws made")
 
 
 def _per_spec(draws) -> str:
@@ -133,15 +205,14 @@ def _per_spec(draws) -> str:
     return ", ".join(f"`{spec}` {n} seed{'s' if n != 1 else ''}" for spec, n in counts.items())
 
 
-def app_draws(paths, seeds, *, runs: int, jobs: int | None = None, timeout: float | None = None) -> list[AppDraw]:
+def app_draws(paths, seeds, *, runs: int, jobs: int | None = None, timeout: float | None = None,
+              journal: Journal | None = None) -> list[AppDraw]:
     """Every right app of ``paths``: its own run, then ``runs`` perturbed runs drawn from each seed."""
-    from concurrent.futures import ThreadPoolExecutor, as_completed
-
     from conformance import apps
     from conformance.apps import perturbed
-    from conformance.progress import progress
 
-    def one(path: str, seed: int) -> AppDraw:
+    def one(item) -> AppDraw:
+        path, seed = item
         start = time.monotonic()
         draw = AppDraw(str(path), seed, runs, 0.0)
         try:
@@ -161,11 +232,8 @@ def app_draws(paths, seeds, *, runs: int, jobs: int | None = None, timeout: floa
         draw.seconds = time.monotonic() - start
         return draw
 
-    with ThreadPoolExecutor(max_workers=jobs or 1) as pool:
-        futures = [pool.submit(one, path, seed) for path in paths for seed in seeds]
-        for _ in progress(as_completed(futures), total=len(futures), what="app draws made"):
-            pass
-        return [f.result() for f in futures]
+    todo = [(("app", str(path), seed, runs), (path, seed)) for path in paths for seed in seeds]
+    return _run_all(todo, one, journal, jobs, "app draws made")
 
 
 def _scene_of(record: dict) -> str:

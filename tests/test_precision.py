@@ -99,3 +99,26 @@ def test_precision_reports_a_wrong_sync_as_a_false_alarm_with_its_replay_line(tm
     again = subprocess.run([sys.executable, *__import__("shlex").split(argv)[1:], "-p", "no:cacheprovider"],
                            capture_output=True, text=True, env={**env, name: value}, timeout=900)
     assert again.returncode == 1 and "failed" in again.stdout, again.stdout[-2000:]
+
+
+def test_a_journal_keeps_each_draw_and_a_run_goes_on_where_it_stopped(tmp_path, monkeypatch):
+    """Each draw is appended as it finishes; a line cut short by a kill is made again, every other draw is
+    not (``precision --journal``)."""
+    from conformance import verdicts
+
+    path = tmp_path / "draws.jsonl"
+    journal = precision.Journal(path)
+    journal.add(precision.SyncDraw("reference", 1, 10, 5.0, 0, [_record("test_a", "chain", "passed", 0.2)]))
+    with open(path, "a", encoding="utf-8") as out:
+        out.write('{"kind": "sync", "draw": {"spec": "reference", "seed": 2')  # killed mid-line
+    made = []
+
+    def check(spec, *, pytest_args, env, timeout):
+        made.append(pytest_args[-1])
+        return verdicts.Outcome(spec, 0, [_record("test_a", "chain", "passed", 0.3)])
+
+    monkeypatch.setattr(verdicts, "check", check)
+    draws = precision.sync_draws(["reference"], [1, 2, 3], factor=10, journal=precision.Journal(path))
+    assert sorted(made) == ["--hypothesis-seed=2", "--hypothesis-seed=3"]
+    assert [d.seed for d in draws] == [1, 2, 3] and draws[0].records[0]["figures"]["vertex position"]["use"] == 0.2
+    assert {k[2] for k in precision.Journal(path).made} == {1, 2, 3}

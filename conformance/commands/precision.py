@@ -36,6 +36,9 @@ def add_arguments(parser) -> None:
     parser.add_argument("--timeout", type=argparse_type(positive_int, "--timeout"), default=3600, metavar="S",
                         help="seconds one process may take before it is stopped (default 3600)")
     parser.add_argument("--out", type=argparse_type(file_to_write, "--out"), default=None, help="also write the markdown here")
+    parser.add_argument("--journal", type=argparse_type(file_to_write, "--journal"), default=None, metavar="FILE.jsonl",
+                        help="keep every draw here as it finishes, and make again only the draws it does not hold: "
+                        "a long run stopped goes on where it was")
 
 
 def run(args, extra) -> int:
@@ -58,10 +61,13 @@ def run(args, extra) -> int:
     def seeds(count):
         return list(range(args.first_seed, args.first_seed + (count or args.seeds)))
 
-    syncs = precision.sync_draws(named, seeds(args.seeds), factor=args.factor, jobs=args.jobs, timeout=args.timeout)
-    syncs += precision.sync_draws(others, seeds(args.right_seeds), factor=args.factor, jobs=args.jobs, timeout=args.timeout)
-    app_runs = precision.app_draws(paths, seeds(args.app_seeds), runs=args.app_runs, jobs=args.jobs,
-                                   timeout=args.timeout) if paths else []
+    journal = precision.Journal(args.journal) if args.journal else None
+    common = {"jobs": args.jobs, "timeout": args.timeout, "journal": journal}
+    # The few draws first, the named syncs' many last: a long run stopped part-way has some of everything,
+    # and with --journal a second run with fewer --seeds tabulates what the first made.
+    app_runs = precision.app_draws(paths, seeds(args.app_seeds), runs=args.app_runs, **common) if paths else []
+    syncs = precision.sync_draws(others, seeds(args.right_seeds), factor=args.factor, **common)
+    syncs = precision.sync_draws(named, seeds(args.seeds), factor=args.factor, **common) + syncs
     made_by = shlex.join(["python", "-m", "conformance", "precision", *args.specs,
                           *[part for module in args.right for part in ("--right", module)],
                           *[part for pattern in args.apps for part in ("--apps", pattern)],
