@@ -37,7 +37,7 @@ settings.register_profile("shrink", deadline=None, print_blob=True, suppress_hea
 # Random draws in bulk, for measuring false alarms (``python -m conformance precision``): no example
 # database (a draw replayed from an earlier run is not a new draw), nothing shrunk, and
 # :data:`PRECISION_FACTOR` times the default's examples in one process (set by $CONFORMANCE_DRAW_FACTOR).
-settings.register_profile("precision", deadline=None, print_blob=True, suppress_health_check=_SLOW_OK,
+settings.register_profile("precision", derandomize=False, deadline=None, print_blob=True, suppress_health_check=_SLOW_OK,
                           database=None, phases=(Phase.explicit, Phase.generate))
 
 #: Examples per profile, as a multiple of what a check asks for under ``default``.
