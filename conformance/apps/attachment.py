@@ -121,7 +121,9 @@ def attach(vertices: np.ndarray, positions: np.ndarray, rotations: np.ndarray, *
     radii = np.ones(frames) if radii is None else np.maximum(np.asarray(radii, dtype=np.float64), 1e-6)
     pos, rot = _world(positions, rotations)
     probes = _probes(ticks, [t - 1 for t in event_ticks] + list(event_ticks))
-    tree = cKDTree(positions[0]) if frames else None
+    # Nearest by where each frame's shape is, not its origin: a gear whose link frame sits on another
+    # gear's axle is still nearest its own teeth.
+    tree = cKDTree(positions[0] + _transposed_times(np.swapaxes(rotations[0], -1, -2), centres)) if frames else None
 
     def nearest(rows: np.ndarray, k: int) -> np.ndarray:
         """The ``k`` frames nearest each of ``rows`` at the first tick, and the world."""
@@ -146,6 +148,8 @@ def attach(vertices: np.ndarray, positions: np.ndarray, rotations: np.ndarray, *
     # smallest by rounding; the world only when no body holds it.
     holding = spreads <= allowance[:, None]
     closeness = np.where(holding, _shape_distance(vertices[0], pos[0], rot[0], candidates, centres, radii), np.inf)
+    if outside is not None and n:
+        closeness = _on_a_shape_first(vertices[0], pos[0], rot[0], candidates, holding, closeness, outside, frames)
     choice = np.where(holding.any(axis=1), np.argmin(closeness, axis=1), np.argmin(spreads, axis=1)) if n else np.zeros(0, int)
     best = candidates[everyone, choice] if n else np.zeros(0, dtype=int)
     best_spread = spreads[everyone, choice] if n else np.zeros(0)
@@ -184,9 +188,70 @@ def attach(vertices: np.ndarray, positions: np.ndarray, rotations: np.ndarray, *
             allowance = _allowance(vertices, pos, rot, best, tolerance)
             local = local_coordinates(vertices, pos[:, best], rot[:, best])
             error = np.linalg.norm(local - np.median(local, axis=0), axis=-1).T
+    if n and frames:
+        moved = _with_the_majority(vertices, pos, rot, best, welded, allowance, error, tolerance, outside)
+        if moved.any():
+            tied = tied & ~moved
+            allowance = _allowance(vertices, pos, rot, best, tolerance)
+            local = local_coordinates(vertices, pos[:, best], rot[:, best])
+            error = np.linalg.norm(local - np.median(local, axis=0), axis=-1).T
     reference = np.median(local, axis=0)
     frame = np.where(best == frames, -1, best)
     return Attachment(frame=frame, error=error, allowance=allowance, reference=reference, tied=tied, welded=welded)
+
+
+def _with_the_majority(vertices, pos, rot, best, welded, allowance, error, tolerance, outside=None) -> np.ndarray:
+    """Move to the frame most of the actor's vertices are held by every vertex that frame holds as well and
+    that lies on no shape of its own frame (``best`` changed in place; which moved). A point on a joint's
+    axis is held by both the link and its parent at every tick (a racecar's chassis vertex on a
+    differential gear's axle): given to the gear by the nearest-frame search, it looked like a piece of
+    the chassis drawn with the gear's pose. Welded frames' vertices keep the member whose shape they lie
+    on, and so does a vertex on its own frame's shape (two gears turning together)."""
+    frames = pos.shape[1] - 1
+    held = np.all(error <= allowance[:, None], axis=1)
+    counts = np.bincount(best[held & (best < frames)], minlength=frames)
+    if not counts.any():
+        return np.zeros(len(best), dtype=bool)
+    majority = int(np.argmax(counts))
+    rows = np.flatnonzero(~welded & (best != majority) & (best < frames))
+    if outside is not None and len(rows):
+        gaps = np.zeros(len(rows))
+        for f in np.unique(best[rows]):
+            mine = best[rows] == f
+            gaps[mine] = outside(int(f), _transposed_times(rot[0, f], vertices[0, rows[mine]] - pos[0, f]))
+        rows = rows[gaps > ON_SHAPE]
+    if not len(rows):
+        return np.zeros(len(best), dtype=bool)
+    trial = best.copy()
+    trial[rows] = majority
+    room = _allowance(vertices, pos, rot, trial, tolerance)[rows]
+    local = local_coordinates(vertices[:, rows], pos[:, trial[rows]], rot[:, trial[rows]])
+    spread = np.max(np.linalg.norm(local - np.median(local, axis=0), axis=-1), axis=0)
+    ok = spread <= room
+    moved = np.zeros(len(best), dtype=bool)
+    moved[rows[ok]] = True
+    best[rows[ok]] = majority
+    return moved
+
+
+def _on_a_shape_first(vertices0, pos0, rot0, candidates, holding, closeness, outside, frames) -> np.ndarray:
+    """``closeness`` with the frames a vertex lies on ranked first where several hold it (two gears turning
+    together, a link and its parent on a still joint): how far outside each frame's shapes it lies
+    (``outside``, to a tenth of a millimetre), then the centre over radius as before."""
+    multi = np.flatnonzero(holding.sum(axis=1) >= 2)
+    if not len(multi):
+        return closeness
+    gaps = np.full((len(multi), candidates.shape[1]), np.inf)
+    for f in np.unique(candidates[multi][holding[multi]]):
+        if f >= frames:
+            continue  # the world: no shape; it holds what no body does
+        rows, cols = np.nonzero((candidates[multi] == f) & holding[multi])
+        local = _transposed_times(rot0[f], vertices0[multi[rows]] - pos0[f])
+        gaps[rows, cols] = outside(int(f), local)
+    closeness = closeness.copy()
+    closeness[multi] = np.where(holding[multi], np.round(np.minimum(gaps, 1e3), 4) * 1e6 + np.minimum(closeness[multi], 1e5),
+                                np.inf)
+    return closeness
 
 
 def _on_welded_shape(vertices0, pos0, rot0, best, groups, centres, radii, outside=None):

@@ -46,6 +46,11 @@ class Frame:
     #: the vertices of its mesh collision shapes in its link frame (``getMeshData``, which pyBullet gives in
     #: the centre-of-mass frame; URDF cylinders are meshes there too), at most :data:`MESH_VERTICES` of them
     mesh: tuple = ()
+    #: its visual shapes as pyBullet holds them (``getVisualShapeData``), each ``(kind, dims, position,
+    #: orientation, points)``: ``dims`` as pyBullet gives them (a mesh's: its scale), the shape's frame in the
+    #: link frame, and ``points`` the shape's extreme points in its own frame, scaled (a mesh's convex hull,
+    #: a box's corners, a cylinder's rims): what a drawing of it spans. pyBullet's own renderer draws these.
+    visuals: tuple = ()
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -85,6 +90,57 @@ def _mesh(p: BoundClient, body: int, link: int, shapes: tuple) -> tuple:
     return tuple(tuple(round(float(c), 9) for c in v) for v in turned)
 
 
+#: Points around a cylinder's rims, for the box a drawing of it spans (0.2 % short of the radius at most).
+RIM = 64
+
+
+def _primitive_points(kind: str, dims) -> np.ndarray | None:
+    """A primitive's extreme points in its own frame (pyBullet's dims: box full extents, sphere radius,
+    cylinder and capsule length and radius along z)."""
+    if kind == "box":
+        half = np.asarray(dims[:3], dtype=np.float64) / 2
+        return np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]) * half
+    if kind == "sphere":
+        return np.concatenate([np.eye(3), -np.eye(3)]) * float(dims[0])
+    if kind in ("cylinder", "capsule"):
+        length, radius = float(dims[0]), float(dims[1])
+        angle = np.linspace(0, 2 * np.pi, RIM, endpoint=False)
+        rim = np.column_stack([radius * np.cos(angle), radius * np.sin(angle), np.zeros(RIM)])
+        ends = length / 2 + (radius if kind == "capsule" else 0.0)
+        return np.concatenate([rim + [0, 0, length / 2], rim - [0, 0, length / 2], [[0, 0, ends], [0, 0, -ends]]])
+    return None
+
+
+def _mesh_points(path: str, scale) -> np.ndarray | None:
+    """A visual mesh file's convex hull vertices, scaled (trimesh reads OBJ, STL, PLY; a file it cannot read: None)."""
+    try:
+        import trimesh
+
+        mesh = trimesh.load(path, force="mesh", skip_materials=True)
+        points = np.asarray(mesh.convex_hull.vertices if len(mesh.vertices) > 3 else mesh.vertices, dtype=np.float64)
+    except Exception:  # a format or file trimesh cannot read: the shape is left out, not the run
+        return None
+    return points * np.asarray(scale, dtype=np.float64)[:3] if len(points) else None
+
+
+def _visuals(p: BoundClient, body: int) -> dict[int, tuple]:
+    """Each link's visual shapes (``getVisualShapeData``), by link index."""
+    found: dict[int, list] = {}
+    try:
+        data = p.getVisualShapeData(body)
+    except pybullet.error:
+        return {}
+    for shape in data:
+        link, kind = shape[1], SHAPE_KINDS.get(shape[2], f"type {shape[2]}")
+        dims, path = tuple(float(v) for v in shape[3]), _text(shape[4])
+        points = _mesh_points(path, dims) if kind == "mesh" else _primitive_points(kind, dims)
+        if points is None:
+            continue
+        found.setdefault(link, []).append((kind, dims, tuple(float(v) for v in shape[5]), tuple(float(v) for v in shape[6]),
+                                           tuple(tuple(round(float(c), 9) for c in v) for v in points)))
+    return {link: tuple(shapes) for link, shapes in found.items()}
+
+
 def _shapes(p: BoundClient, body: int, link: int) -> tuple:
     inertial_pos, inertial_orn = p.getDynamicsInfo(body, link)[3:5]
     found = []
@@ -104,12 +160,13 @@ def frames_of(clients) -> list[Frame]:
             body = p.getBodyUniqueId(index)
             base_name, body_name = (_text(v) for v in p.getBodyInfo(body))
             name = body_name if body_name and body_name != base_name else base_name
+            visuals = _visuals(p, body)
             for link in range(-1, p.getNumJoints(body)):
                 info = p.getDynamicsInfo(body, link)
                 shapes = _shapes(p, body, link)
                 label = name if link == -1 else _text(p.getJointInfo(body, link)[12])
                 frames.append(Frame(client, body, link, label, float(info[0]), shapes, tuple(info[3]),
-                                    _mesh(p, body, link, shapes)))
+                                    _mesh(p, body, link, shapes), visuals.get(link, ())))
     return frames
 
 

@@ -44,6 +44,13 @@ DIAGNOSES = {name: text for name, (text, _) in attach_mod.VARIANTS.items()} | {
     "never-moved": "left where it was built while its body moves: the sync never sets this actor (or this range)",
     "other-body": "follows another body's frame: the vertex range or the actor was paired with the wrong body",
     "turned-shape": "the actor was built turned in its body's frame (a box's directions, a cylinder's axis)",
+    "offset-sign": "drawn with the centre-of-mass offset applied the wrong way (twice its offset from the link frame, or "
+                   "undone twice): the link frame is the centre of mass moved by minus getDynamicsInfo(body, link)[3:5], "
+                   "turned by the centre of mass's orientation",
+    "visual-frame": "drawn without its visual frame: a URDF places each visual shape in its link frame "
+                    "(getVisualShapeData(body)[i][5:7], the <visual><origin>), which the actor must be moved by",
+    "mesh-scale": "drawn without its mesh scale: getVisualShapeData(body)[i][3] (the URDF's <mesh scale>) scales the "
+                  "mesh file's vertices",
     "stale-normals": "the vertices turn but the stored normals do not: turn normals with the same rotation",
     "unannounced": "vertex data changed without telling the renderer, which keeps drawing the old data: call "
                    "utils.update_actor (FURY 0.12); on FURY 2 call update_range (or update_full) on every buffer "
@@ -53,9 +60,10 @@ DIAGNOSES = {name: text for name, (text, _) in attach_mod.VARIANTS.items()} | {
                     "velocity to zero (pybullet 3.2.7), so the simulation is changed; a sync only reads",
     "hidden": "its actor is hidden (SetVisibility(0) on FURY 0.12, visible = False on FURY 2) or drawn fainter than "
               "opacity 32/255, so the picture does not show a body pyBullet has there: keep each body's actor shown",
-    "not-its-shape": "nothing draws the shape pyBullet simulates for this body: every drawing it holds is another "
-                     "shape (another size, or turned) than its collision shape, and the picture differs from "
-                     "pyBullet's own: build the actor from the collision shape's dimensions and orientation",
+    "not-its-shape": "nothing draws the shape pyBullet has for this body: every drawing it holds is another shape "
+                     "(another size, or turned) than its visual shapes (getVisualShapeData) or, without them, its "
+                     "collision shape, and the picture differs from pyBullet's own: build the actor from those "
+                     "shapes' dimensions, frames and scales",
     "skipped": "drawn where it was before the tick's step at some ticks only: at other ticks where pyBullet moved it "
                "it is drawn right, so the sync is not late but skips the body on some condition (zero velocity, "
                "a sleeping flag, a pose it takes as unchanged, every other call): draw every body whenever the "
@@ -111,9 +119,9 @@ class _Judgement:
         self._placements = None
 
     def _outside(self, frame: int, points: np.ndarray) -> np.ndarray:
-        """How far link-frame ``points`` lie outside ``frame``'s collision shapes (0 on or inside)."""
+        """How far link-frame ``points`` lie outside ``frame``'s collision and visual shapes (0 on or inside one)."""
         info = self.r.frames[frame]
-        return distance_to_shapes(points, info.shapes, info.mesh)
+        return distance_to_shapes(points, info.shapes, info.mesh, info.visuals)
 
     def _apply_mapping(self, entry: dict) -> None:
         """Judge the mapped vertices in the frame the mapping names, not the one that holds them best:
@@ -187,7 +195,7 @@ class _Judgement:
                     groups.setdefault(int(g), []).append(self.r.frames[i].name or self.frame_label(i))
             together = "; ".join(" + ".join(names) for names in groups.values())
             verdict.notes.append(f"{welded} vertices are held by frames welded together (fixed joints, or links that never "
-                                 f"moved apart: {together}): each went to the frame whose collision shape it lies on")
+                                 f"moved apart: {together}): each went to the frame whose shape it lies on")
         verdict.worst = worst
         return verdict
 
@@ -372,7 +380,7 @@ class _Judgement:
                         continue
                     info = self.r.frames[frame]
                     result = place(_drawn_points(a.reference[rows], track.radii, rows), info.shapes,
-                                   self._inertial(frame), tolerance=self.tolerance)
+                                   self._inertial(frame), tolerance=self.tolerance, mesh=info.mesh, visuals=info.visuals)
                     self._placements.append((track, a, int(frame), rows, result))
         return self._placements
 

@@ -54,18 +54,39 @@ ROUNDED_SLACK = 2
 
 def _statuses(judgement) -> tuple[set[int], set[int], set[int]]:
     """The frames judged in pictures, the background ones (static bases), and the judged frames that
-    nothing draws as their collision shape; all others are unknown."""
+    nothing draws as their shape; all others are unknown. pyBullet's renderer draws a frame's visual
+    shapes where it has any (a URDF's), else its collision shapes: a frame is judged where a drawing it
+    holds is that shape."""
     r = judgement.r
     background = {i for i, f in enumerate(r.frames) if f.mass == 0 and f.link == -1}
-    judged, refused = set(), set()
+    judged, refused, elsewise = set(), set(), set()
     for _track, _a, frame, _rows, result in judgement.placements():
-        (judged if result.judged else refused).add(frame)
-    kinds = {i for i, f in enumerate(r.frames) if len(f.shapes) == 1 and f.shapes[0][0] in silhouettes.MIN_IOU}
-    # A body whose every drawing is another shape than its collision shape (FURY 0.12's own chain demo draws
+        drawn = "visual" if r.frames[frame].visuals else "collision"
+        if result.judged and result.shape == drawn:
+            judged.add(frame)
+        elif result.judged and result.ok:
+            elsewise.add(frame)  # right, as another of its shapes (its collision shape where pyBullet draws a visual)
+        else:
+            refused.add(frame)
+    refused -= elsewise
+    kinds = {i for i, f in enumerate(r.frames) if (not f.visuals and len(f.shapes) == 1 and f.shapes[0][0] in silhouettes.MIN_IOU)
+             or (f.visuals and all(v[0] in silhouettes.MIN_IOU or v[0] == "mesh" for v in f.visuals))}
+    # A body whose every drawing is another shape than the one pyBullet draws (FURY 0.12's own chain demo draws
     # 1 m discs as thin rods) is still held to pyBullet's picture of it: "a picture that is not what the
     # physics says is wrong". A body with a decoration beside a drawing of its shape stays unknown.
     unlike = (refused - judged - background) & kinds
-    return ((judged - refused - background) & kinds) | unlike, background, unlike
+    return ((judged - refused - elsewise - background) & kinds) | unlike, background, unlike
+
+
+def limits_of(frame) -> tuple[float, tuple[float, float] | None]:
+    """The silhouette threshold and sphere rounding of what pyBullet's renderer draws of ``frame``: its visual
+    shapes where it has any (a mesh is drawn from the same triangles by both: a box's threshold), else its
+    one collision shape."""
+    kinds = [v[0] for v in frame.visuals] or ([frame.shapes[0][0]] if len(frame.shapes) == 1 else [])
+    if not kinds:
+        return 1.0, None
+    limit = min(silhouettes.MIN_IOU.get(kind, silhouettes.MIN_IOU["box"]) for kind in kinds)
+    return limit, (silhouettes.ROUNDING.get(kinds[0]) if len(kinds) == 1 else None)
 
 
 def labels(shot: dict, recording, attachments, judged: set[int], background: set[int],
@@ -180,7 +201,8 @@ def _discs(shot: dict, recording, rounding) -> list:
     size = tuple(shot["size"])
     centres, radii = [], []
     for i in spheres:
-        kind, dims, position, orientation = recording.frames[i].shapes[0]
+        frame = recording.frames[i]
+        kind, dims, position, orientation = frame.visuals[0][:4] if frame.visuals else frame.shapes[0]
         turn = Rotation.from_quat(recording.orientations[tick, i])
         centres.append(turn.apply(position) + recording.positions[tick, i])
         radii.append(float(dims[0]))
@@ -221,10 +243,11 @@ def check(judgement):
     verdict = Verdict("pictured", True)
     judged, background, unlike = _statuses(judgement)
     names = [f.label for f in r.frames]
-    limits = [silhouettes.MIN_IOU.get(f.shapes[0][0], 1.0) if len(f.shapes) == 1 else 1.0 for f in r.frames]
-    rounding = [silhouettes.ROUNDING.get(f.shapes[0][0]) if len(f.shapes) == 1 else None for f in r.frames]
+    limits, rounding = zip(*[limits_of(f) for f in r.frames]) if r.frames else ((), ())
+    limits, rounding = list(limits), list(rounding)
     app = Path(r.script).name
-    rounded = {i for i in judged if r.frames[i].shapes[0][0] in ("sphere", "cylinder")}
+    rounded = {i for i in judged if {v[0] for v in r.frames[i].visuals} & {"sphere", "cylinder"}
+               or (not r.frames[i].visuals and r.frames[i].shapes and r.frames[i].shapes[0][0] in ("sphere", "cylinder"))}
     worst = None
     decorations = _decorations(judgement, unlike)
     for shot in r.pictures:

@@ -26,7 +26,7 @@ from scipy.spatial.transform import Rotation
 
 from conformance.tolerances import DEFAULT, Tolerance
 
-__all__ = ["Placement", "bounding_radius", "bounding_sphere", "distance_to_shapes", "place", "shape_box"]
+__all__ = ["Placement", "bounding_radius", "bounding_sphere", "candidates", "distance_to_shapes", "place", "shape_box"]
 
 #: A drawing of another size than the collision shape is not judged, unless a vertex it holds lies further
 #: from the shape's centre than REACH times the shape's radius plus REACH_MARGIN: no decoration of a body
@@ -79,13 +79,16 @@ def bounding_sphere(shapes, mesh=()) -> tuple[np.ndarray, float]:
     return box[0], float(np.linalg.norm(box[1]))
 
 
-def distance_to_shapes(points: np.ndarray, shapes, mesh=()) -> np.ndarray:
+def distance_to_shapes(points: np.ndarray, shapes, mesh=(), visuals=()) -> np.ndarray:
     """How far each of ``points`` ``(m, 3)`` (link-frame coordinates) lies outside a frame's collision
     shapes, 0 on or inside one: boxes, spheres, cylinders and capsules exactly, mesh shapes by the convex
-    hull of ``mesh`` (pyBullet collides a mesh as its hull unless told otherwise); inf for a frame with
-    none of them (a plane, say)."""
+    hull of ``mesh`` (pyBullet collides a mesh as its hull unless told otherwise); and outside each of its
+    ``visuals`` (:attr:`~conformance.apps.bodies.Frame.visuals`, by the hull of their points); inf for a
+    frame with none of them (a plane, say)."""
     points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     best = np.full(len(points), np.inf)
+    for visual in visuals:
+        best = np.minimum(best, _outside_hull(points, _framed(visual)))
     for kind, dims, position, orientation in shapes:
         local = (points - np.asarray(position)) @ Rotation.from_quat(orientation).as_matrix()
         if kind == "box":
@@ -130,42 +133,126 @@ class Placement:
     why: str
     offset: np.ndarray | None = None
     diagnosis: str = ""
+    #: which of the frame's shapes the drawing is: "collision", "visual" (one of its visual shapes, or all
+    #: of them together), or "" (not judged)
+    shape: str = ""
 
 
-def place(reference: np.ndarray, shapes, inertial_position, *, tolerance: Tolerance = DEFAULT) -> Placement:
-    """Judge the link-frame coordinates ``reference`` ``(m, 3)`` of the vertices one frame holds in one
-    actor against the frame's collision ``shapes``; ``inertial_position`` is the centre of mass in the
-    link frame (``getDynamicsInfo(body, link)[3]``), to recognise a drawing made at the centre of mass."""
+def _box(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    low, high = points.min(axis=0), points.max(axis=0)
+    return (low + high) / 2, (high - low) / 2
+
+
+def _framed(visual) -> np.ndarray:
+    """A visual shape's points in the link frame: its own points moved by its local frame."""
+    kind, dims, position, orientation, points = visual
+    return np.asarray(points, dtype=np.float64) @ Rotation.from_quat(orientation).as_matrix().T + np.asarray(position)
+
+
+def candidates(shapes, mesh=(), visuals=()) -> list[tuple[str, str, np.ndarray, np.ndarray]]:
+    """The shapes a right drawing of a frame may be, each ``(what, which, centre, half extents)`` in the link
+    frame's axes: each of its visual shapes, and all of them together (a link drawn from every visual it
+    has); its one box, sphere or cylinder collision shape, or its collision mesh."""
+    found = []
+    # The visual shapes first: where a frame has them pyBullet's renderer draws them, so a drawing that is
+    # both (a URDF box whose visual and collision are one) is judged in pictures too.
+    framed = [_framed(v) for v in visuals]
+    for v, points in zip(visuals, framed):
+        found.append((f"its visual shape ({v[0]})", "visual", *_box(points)))
+    if len(framed) > 1:
+        found.append((f"its {len(framed)} visual shapes together", "visual", *_box(np.concatenate(framed))))
     box = shape_box(shapes)
-    if box is None:
+    if box is not None:
+        found.append((f"its collision shape ({shapes[0][0]})", "collision", *box))
+    elif len(mesh) and len(shapes) == 1:
+        found.append(("its collision mesh", "collision", *_box(np.asarray(mesh, dtype=np.float64))))
+    return found
+
+
+def _mistakes(visuals) -> list[tuple[str, np.ndarray, np.ndarray]]:
+    """What a drawing of a frame's visual shapes spans when their usual mistakes are made, ``(diagnosis,
+    centre, half)``, for each shape and for all of them together: drawn without its visual frame
+    (``getVisualShapeData(...)[5:7]`` left out), a mesh drawn without its scale."""
+    unframed, unscaled = [], []
+    for kind, dims, position, orientation, points in visuals:
+        own = np.asarray(points, dtype=np.float64)
+        framed = np.linalg.norm(position) > 1e-9 or abs(abs(orientation[3]) - 1) > 1e-9
+        unframed.append(own if framed else None)
+        scale = np.asarray(dims[:3], dtype=np.float64)
+        scaled = kind == "mesh" and np.all(scale > 0) and np.any(np.abs(scale - 1) > 1e-6)
+        unscaled.append(_framed((kind, dims, position, orientation, own / scale)) if scaled else None)
+    found = []
+    for diagnosis, wrong, right in (("visual-frame", unframed, [None] * len(visuals)), ("mesh-scale", unscaled, [None] * len(visuals))):
+        if not any(w is not None for w in wrong):
+            continue
+        found += [(diagnosis, *_box(w)) for w in wrong if w is not None]
+        if len(visuals) > 1:  # the link drawn from all its visuals, each with the mistake where it applies
+            together = [w if w is not None else _framed(v) for w, v in zip(wrong, visuals)]
+            found.append((diagnosis, *_box(np.concatenate(together))))
+    return found
+
+
+def place(reference: np.ndarray, shapes, inertial_position, *, tolerance: Tolerance = DEFAULT, mesh=(),
+          visuals=()) -> Placement:
+    """Judge the link-frame coordinates ``reference`` ``(m, 3)`` of the vertices one frame holds in one
+    actor against the frame's shapes (:func:`candidates`: its collision shape, its visual shapes as
+    ``getVisualShapeData`` holds them, with their local frames and scales); ``inertial_position`` is the
+    centre of mass in the link frame (``getDynamicsInfo(body, link)[3]``), to recognise a drawing made at
+    the centre of mass, or with its offset the wrong way."""
+    shapes_of = candidates(shapes, mesh, visuals)
+    if not shapes_of:
         kinds = ", ".join(s[0] for s in shapes) or "none"
-        return Placement(False, True, f"not judged: the frame's collision shapes ({kinds}) are not one box, sphere or cylinder")
-    centre, half = box
-    low, high = reference.min(axis=0), reference.max(axis=0)
-    drawn_centre, drawn_half = (low + high) / 2, (high - low) / 2
-    allowance = tolerance.bounds_rtol * 2 * float(np.max(half)) + 1e-9
-    if np.all(np.abs(drawn_half - half) <= allowance):
+        return Placement(False, True, f"not judged: the frame's collision shapes ({kinds}) are not one box, sphere or "
+                         "cylinder, and it has no visual shape pyBullet holds")
+    drawn_centre, drawn_half = _box(reference)
+
+    def allowance(half) -> float:
+        return tolerance.bounds_rtol * 2 * float(np.max(half)) + 1e-9
+
+    for what, which, centre, half in shapes_of:
+        room = allowance(half)
+        if not np.all(np.abs(drawn_half - half) <= room):
+            continue
         offset = drawn_centre - centre
-        if np.all(np.abs(offset) <= allowance):
-            return Placement(True, True, "on its collision shape")
-        diagnosis = ""
+        if np.all(np.abs(offset) <= room):
+            return Placement(True, True, f"on {what}", shape=which)
         inertial = np.asarray(inertial_position, dtype=np.float64)
-        if np.linalg.norm(inertial) > allowance and np.all(np.abs(offset - inertial) <= allowance):
-            diagnosis = "com-frame"
-        return Placement(True, False, f"drawn {np.linalg.norm(offset):.4g} m off its collision shape (drawn centre "
-                         f"{_v(drawn_centre)} in the link frame, the shape's {_v(centre)}; allowed {allowance:.3g} m)",
-                         offset, diagnosis)
-    if np.all(np.abs(np.sort(drawn_half) - np.sort(half)) <= allowance):
-        return Placement(True, False, f"drawn turned in its frame: half extents {_v(drawn_half)} in the link frame's "
-                         f"axes where the collision shape's are {_v(half)}", diagnosis="turned-shape")
+        diagnosis = ""
+        if np.linalg.norm(inertial) > room:
+            if np.all(np.abs(offset - inertial) <= room):
+                diagnosis = "com-frame"
+            elif np.all(np.abs(offset - 2 * inertial) <= room) or np.all(np.abs(offset + inertial) <= room):
+                diagnosis = "offset-sign"
+        for mistake, m_centre, m_half in _mistakes(visuals):
+            if not diagnosis and np.all(np.abs(m_half - drawn_half) <= room) and np.all(np.abs(m_centre - drawn_centre) <= room):
+                diagnosis = mistake
+        return Placement(True, False, f"drawn {np.linalg.norm(offset):.4g} m off {what} (drawn centre "
+                         f"{_v(drawn_centre)} in the link frame, the shape's {_v(centre)}; allowed {room:.3g} m)",
+                         offset, diagnosis, which)
+    for mistake, m_centre, m_half in _mistakes(visuals):
+        room = allowance(m_half)
+        if np.all(np.abs(m_half - drawn_half) <= room) and np.all(np.abs(m_centre - drawn_centre) <= room):
+            return Placement(True, False, f"drawn as its visual shape {_MISTAKEN[mistake]} (half extents {_v(drawn_half)}, "
+                             f"centre {_v(drawn_centre)} in the link frame)", drawn_centre, mistake, "visual")
+    for what, which, centre, half in shapes_of:
+        if np.all(np.abs(np.sort(drawn_half) - np.sort(half)) <= allowance(half)):
+            return Placement(True, False, f"drawn turned in its frame: half extents {_v(drawn_half)} in the link frame's "
+                             f"axes where {what}'s are {_v(half)}", diagnosis="turned-shape", shape=which)
+    what, which, centre, half = shapes_of[0]
     reach = float(np.max(np.linalg.norm(reference - centre, axis=1)))
     limit = REACH * float(np.linalg.norm(half)) + REACH_MARGIN
     if reach > limit:
-        return Placement(True, False, f"reaches {reach:.3g} m from its collision shape's centre, more than {REACH:g} times "
+        return Placement(True, False, f"reaches {reach:.3g} m from {what}'s centre, more than {REACH:g} times "
                          f"the shape's radius ({float(np.linalg.norm(half)):.3g} m) and {REACH_MARGIN:g} m: drawn with this "
-                         "frame's pose but elsewhere", drawn_centre - centre, "other-body")
-    return Placement(False, True, f"not judged: the drawn shape (half extents {_v(drawn_half)}) is not the collision "
-                     f"shape ({shapes[0][0]}, half extents {_v(half)})")
+                         "frame's pose but elsewhere", drawn_centre - centre, "other-body", which)
+    known = "; ".join(f"{what}, half extents {_v(half)}" for what, _, _, half in shapes_of)
+    return Placement(False, True, f"not judged: the drawn shape (half extents {_v(drawn_half)}) is none of the frame's "
+                     f"shapes ({known})")
+
+
+#: How each mistaken drawing of a visual shape is told.
+_MISTAKEN = {"visual-frame": "without its visual frame (getVisualShapeData(...)[5:7])",
+             "mesh-scale": "without its mesh scale (getVisualShapeData(...)[3])"}
 
 
 def _v(values) -> str:

@@ -2,13 +2,13 @@
 
 A robot as users load it: ``p.loadURDF("r2d2.urdf")`` from ``pybullet_data``, with its fixed joints kept
 (legs and wheel bases welded to the body, finger tips to the fingers, the box on the head), so six of
-its 15 links never move relative to their parent. Each link is one actor built from the link's
-collision shapes, as pyBullet holds them, in the link's centre-of-mass frame: boxes and the head's
-sphere from ``getCollisionShapeData`` (dimensions, and the shape's frame relative to the centre of
-mass), the cylinders and finger meshes (which pyBullet keeps as convex meshes) from
-``getMeshData``'s vertices (already in that frame), closed by their convex hull. After every step each
-actor's user matrix is its link's centre-of-mass pose: ``getBasePositionAndOrientation`` for the base,
-``getLinkState(robot, j, computeForwardKinematics=1)[0:2]`` for a link.
+its 15 links never move relative to their parent. Each link is one actor built from the link's visual
+shapes as pyBullet holds them (``getVisualShapeData``: the kind and dimensions, a mesh's file and
+scale, and the shape's frame in the link frame): boxes, cylinders and the head's sphere made with
+trimesh, the finger meshes read with it, each moved once by its visual frame. After every step each
+actor is placed at its link frame: ``getLinkState(robot, j, computeForwardKinematics=1)[4:6]`` for a
+link, and for the base ``getBasePositionAndOrientation`` with its centre-of-mass offset undone
+(``getDynamicsInfo(robot, -1)[3:5]``).
 
 The wheels turn on velocity motors (the right pair faster, so it arcs), the head swivels, the gripper
 pole slides out and the fingers open and close; gravity -10, 1/240 s, 150 steps, on ``plane.urdf``.
@@ -22,7 +22,7 @@ import numpy as np
 import pybullet as p
 import pybullet_data
 from fury import actor, primitive, utils, window
-from scipy.spatial import ConvexHull
+import trimesh
 from vtkmodules.vtkCommonMath import vtkMatrix4x4
 
 client = p.connect(p.DIRECT)
@@ -46,26 +46,25 @@ def quaternion_matrix(q):
 
 
 def link_geometry(j):
-    """The link's collision shapes as one triangle mesh, in its centre-of-mass frame."""
+    """The link's visual shapes as one triangle mesh, in its link frame."""
     vertices, triangles = [], []
-    mesh_vertices = p.getMeshData(robot, j)[1] if p.getMeshData(robot, j)[0] else []
-    for shape in p.getCollisionShapeData(robot, j):
-        kind, dims, local_pos, local_orn = shape[2], shape[3], shape[5], shape[6]
-        if kind == p.GEOM_BOX:
-            v, f = primitive.prim_box()
-            v = v * np.asarray(dims)                      # a unit cube, scaled to the box's full extents
+    for shape in p.getVisualShapeData(robot):
+        if shape[1] != j:
+            continue
+        kind, dims, path, local_pos, local_orn = shape[2], shape[3], shape[4], shape[5], shape[6]
+        if kind == p.GEOM_MESH:
+            mesh = trimesh.load(path.decode(), force="mesh")
+            mesh.apply_scale(dims)
+        elif kind == p.GEOM_BOX:
+            mesh = trimesh.creation.box(extents=dims)
+        elif kind == p.GEOM_CYLINDER:
+            mesh = trimesh.creation.cylinder(radius=dims[1], height=dims[0], sections=32)
         elif kind == p.GEOM_SPHERE:
-            v, f = primitive.prim_sphere(name="repulsion724")
-            v = v * dims[0] / np.linalg.norm(v, axis=1).max()
-        elif kind == p.GEOM_MESH and len(mesh_vertices):
-            v = np.asarray(mesh_vertices, dtype=float)    # getMeshData: already in the centre-of-mass frame
-            hull = ConvexHull(v)
-            v, f = v[hull.vertices], np.searchsorted(hull.vertices, hull.simplices)
-            local_pos, local_orn = (0, 0, 0), (0, 0, 0, 1)
+            mesh = trimesh.creation.icosphere(subdivisions=3, radius=dims[0])
         else:
             continue
-        v = v @ quaternion_matrix(local_orn).T + local_pos
-        triangles.append(f + sum(len(x) for x in vertices))
+        v = np.asarray(mesh.vertices) @ quaternion_matrix(local_orn).T + local_pos
+        triangles.append(np.asarray(mesh.faces) + sum(len(x) for x in vertices))
         vertices.append(v)
     return np.concatenate(vertices), np.concatenate(triangles)
 
@@ -77,15 +76,17 @@ for k, j in enumerate(links):
     link_actors.append(utils.get_actor_from_primitive(v, f.astype(int), colors=np.tile(colors[k], (len(v), 1))))
 
 
-def centre_of_mass_pose(j):
+def link_frame(j):
     if j == -1:
-        return p.getBasePositionAndOrientation(robot)
-    return p.getLinkState(robot, j, computeForwardKinematics=1)[0:2]
+        com_pos, com_orn = p.getBasePositionAndOrientation(robot)
+        inertial_pos, inertial_orn = p.getDynamicsInfo(robot, -1)[3:5]
+        return p.multiplyTransforms(com_pos, com_orn, *p.invertTransform(inertial_pos, inertial_orn))
+    return p.getLinkState(robot, j, computeForwardKinematics=1)[4:6]
 
 
 def sync_actors():
     for j, link_actor in zip(links, link_actors):
-        pos, orn = centre_of_mass_pose(j)
+        pos, orn = link_frame(j)
         matrix = np.eye(4)
         matrix[:3, :3] = quaternion_matrix(orn)
         matrix[:3, 3] = pos
