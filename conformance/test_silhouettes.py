@@ -46,6 +46,7 @@ def _record(run, sync: str, ids_fury, ids_bullet):
     record = silhouettes.compare_silhouettes(
         ids_fury, ids_bullet, min_iou=silhouettes.thresholds(scene.bindings), rounding=silhouettes.roundings(scene.bindings),
         discs=silhouettes.projected_discs(scene, scene.bindings, scene.camera, scene.image_size),
+        radii=silhouettes.projected_radii(scene, scene.bindings, scene.camera, scene.image_size),
         names=[t.name for t in run.drawing.targets], scene=scene.name, frame=run.frame,
         touching=silhouettes.touching_pairs(scene, scene.bindings, ids_fury, ids_bullet))
     record.sync = sync

@@ -54,6 +54,7 @@ def silhouette_verdicts(spec: str, scene: str, *, camera=None):
             records.append(silhouettes.compare_silhouettes(ids, mask, min_iou=silhouettes.thresholds(run.scene.bindings),
                                                            rounding=silhouettes.roundings(run.scene.bindings),
                                                            discs=silhouettes.projected_discs(run.scene, run.scene.bindings, run.scene.camera, run.scene.image_size),
+                                                           radii=silhouettes.projected_radii(run.scene, run.scene.bindings, run.scene.camera, run.scene.image_size),
                                                            names=[t.name for t in run.drawing.targets]))
     return records
 

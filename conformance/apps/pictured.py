@@ -186,32 +186,38 @@ def edges_only(fury: np.ndarray, bullet: np.ndarray, slack: int = silhouettes.SL
     return np.isin(fury, thin) | np.isin(bullet, thin)
 
 
-def _discs(shot: dict, recording, rounding) -> list:
+def _rounds(shot: dict, recording, rounding) -> tuple[list, list]:
     """Where each sphere frame is in the picture at the shot's tick, as physics has it (column, row, radius
-    in pixels: :func:`conformance.rendering.silhouettes.projected_discs`, from the recorded poses)."""
+    in pixels: :func:`conformance.rendering.silhouettes.projected_discs`, from the recorded poses), and each
+    cylinder frame's radius on screen (:func:`~conformance.rendering.silhouettes.projected_radii`)."""
     from conformance.apps.picture import Camera
     from conformance.rendering import projection
 
-    spheres = [i for i, kind in enumerate(rounding) if kind is not None]
-    found = [None] * len(recording.frames)
+    rounded = [i for i, kind in enumerate(rounding) if kind is not None]
+    discs, radii = [None] * len(recording.frames), [None] * len(recording.frames)
     tick = int(shot["tick"])
-    if not spheres or not 0 <= tick < len(recording.positions) or not shot.get("camera"):
-        return found
+    if not rounded or not 0 <= tick < len(recording.positions) or not shot.get("camera"):
+        return discs, radii
     camera = Camera(**{k: tuple(v) if isinstance(v, list) else v for k, v in shot["camera"].items()})
     size = tuple(shot["size"])
-    centres, radii = [], []
-    for i in spheres:
+    centres, sizes, kinds = [], [], []
+    for i in rounded:
         frame = recording.frames[i]
         kind, dims, position, orientation = frame.visuals[0][:4] if frame.visuals else frame.shapes[0]
         turn = Rotation.from_quat(recording.orientations[tick, i])
         centres.append(turn.apply(position) + recording.positions[tick, i])
-        radii.append(float(dims[0]))
+        sizes.append(float(dims[0] if kind == "sphere" else dims[1]))  # pyBullet's dims: (r,) or (length, r)
+        kinds.append(kind)
     pixels, depth = projection.project(camera, size, np.array(centres))
     per_metre = size[1] / 2 / np.tan(np.radians(camera.view_angle) / 2)
-    for i, (column, row), d, radius in zip(spheres, pixels, depth, radii):
-        if d > 0:
-            found[i] = (float(column), float(row), radius * per_metre / float(d))
-    return found
+    for i, (column, row), d, radius, kind in zip(rounded, pixels, depth, sizes, kinds):
+        if d <= 0:
+            continue
+        if kind == "sphere":
+            discs[i] = (float(column), float(row), radius * per_metre / float(d))
+        else:
+            radii[i] = radius * per_metre / float(d)
+    return discs, radii
 
 
 def _diagnosis(frame: int, shot: dict, recording, attachments) -> str:
@@ -265,8 +271,9 @@ def check(judgement):
                                  "both pictures (a sliver, which each renderer's tessellation decides): left out")
             fury[rims], bullet[rims] = -1, -1
         touching = {tuple(p) for p in shot.get("touching", [])}
+        discs, radii = _rounds(shot, r, rounding)
         record = silhouettes.compare_silhouettes(fury, bullet, min_iou=limits, rounding=rounding, names=names,
-                                                 discs=_discs(shot, r, rounding), scene=f"app-{Path(r.script).stem}",
+                                                 discs=discs, radii=radii, scene=f"app-{Path(r.script).stem}",
                                                  frame=int(shot["tick"]), touching=touching)
         record.sync = "app"
         record.params = {"events": r.events}

@@ -55,6 +55,7 @@ def measure(scene_names, draws: int, seed: int = 0, keep=None) -> list[dict]:
                 record = silhouettes.compare_silhouettes(
                     fury, bullet, min_iou=silhouettes.thresholds(scene.bindings), rounding=silhouettes.roundings(scene.bindings),
                     discs=silhouettes.projected_discs(scene, scene.bindings, scene.camera, scene.image_size),
+                    radii=silhouettes.projected_radii(scene, scene.bindings, scene.camera, scene.image_size),
                     names=[t.name for t in run.drawing.targets], scene=scene_name, frame=run.frame,
                     touching=silhouettes.touching_pairs(scene, scene.bindings, fury, bullet))
                 where = f"{scene_name}({', '.join(f'{k}={v!r}' for k, v in params.items())}), frame {run.frame}" + (

@@ -51,7 +51,7 @@ from . import projection
 from .records import ImageCheck
 
 __all__ = ["LEAST_OFF", "MIN_IOU", "MIN_PIXELS", "ROUNDING", "SLACK", "TOUCHING", "compare_silhouettes", "mask_images",
-           "projected_discs", "pybullet_mask", "rounded_slacks", "roundings", "thresholds", "touching_pairs"]
+           "projected_discs", "projected_radii", "pybullet_mask", "rounded_slacks", "roundings", "thresholds", "touching_pairs"]
 
 #: A target is judged only where it covers at least this many pixels in either mask: below that its
 #: IoU is dominated by which edge pixels each rasteriser keeps.
@@ -82,7 +82,11 @@ LEAST_OFF = 6
 #: the radius inside (1 - cos 12.6°, the half diagonal of an equatorial face; measured on the kit's mesh
 #: in tests/test_silhouettes.py). Without it a right sync failed every random draw that made a sphere
 #: large on screen: free_fall's sphere at 31,000 pixels, IoU 0.962, pyBullet's outline 5 px inside FURY's.
-ROUNDING = {"sphere": (0.03, 0.08)}
+ROUNDING = {"sphere": (0.03, 0.08), "cylinder": (0.02, 0.03)}
+#: A cylinder's rim likewise: pyBullet's lies up to 2.8 % of the radius inside the true circle (measured over
+#: 30 turns about its axis, a 160-px rim seen end-on), FURY's 16-sided one 1.9 % (1 - cos 11.25°). Without
+#: it a right app failed a perturbed run: FURY 0.12's chain example with its discs kicked into a stack, a
+#: disc seen edge-on 45 pixels off where 34 were allowed, all of them on its outline.
 
 
 def pybullet_mask(scene, bindings: Sequence, camera, size, *, depth: bool = False):
@@ -170,7 +174,7 @@ def compare_silhouettes(ids_fury: np.ndarray, ids_pybullet: np.ndarray, *, min_p
                         frame: int = 0, touching: set[tuple[int, int]] | None = None,
                         rounding: Sequence[tuple[float, float] | None] | None = None,
                         discs: Sequence[tuple[float, float, float] | None] | None = None,
-                        least_off: int = LEAST_OFF) -> ImageCheck:
+                        radii: Sequence[float | None] | None = None, least_off: int = LEAST_OFF) -> ImageCheck:
     """Per target, how well FURY's silhouette and pyBullet's agree, for every target covering at least
     ``min_pixels`` pixels in either mask; passes when each such target's IoU is at least its ``min_iou``
     (one number for every target, or a sequence indexed by target, e.g. :func:`thresholds`), or when it
@@ -186,7 +190,9 @@ def compare_silhouettes(ids_fury: np.ndarray, ids_pybullet: np.ndarray, *, min_p
     where its outline meets another target. ``discs`` are where the spheres are on screen, as physics
     has them (:func:`projected_discs`: column, row and radius in pixels): a pixel FURY draws of a sphere
     inside its disc (grown by the slack) is the sphere's, however little of pyBullet's coarser sphere
-    shows near it (a sphere hidden but for a rim past another body's edge). ``names`` name the targets."""
+    shows near it (a sphere hidden but for a rim past another body's edge). ``radii`` are the other
+    rounded targets' radii on screen (a cylinder's rim: :func:`projected_radii`), which scale their slack
+    as a disc's radius does a sphere's. ``names`` name the targets."""
     if ids_fury.shape != ids_pybullet.shape:
         raise ValueError(f"mask shapes differ: {ids_fury.shape} vs {ids_pybullet.shape}")
     count = int(max(ids_fury.max(initial=-1), ids_pybullet.max(initial=-1), len(names) - 1)) + 1
@@ -194,7 +200,9 @@ def compare_silhouettes(ids_fury: np.ndarray, ids_pybullet: np.ndarray, *, min_p
     rounding += [None] * (count - len(rounding))
     discs = list(discs) if discs is not None else []
     discs += [None] * (count - len(discs))
-    radii = [d[2] if d is not None else None for d in discs]
+    given = list(radii) if radii is not None else []
+    given += [None] * (count - len(given))
+    radii = [d[2] if d is not None else r for d, r in zip(discs, given)]
     # Where two bodies touch or interpenetrate, which one is in front depends on each renderer's
     # tessellation and depth test (measured: a cylinder cut by a turned ground, 13 FURY pixels against
     # 68 pyBullet pixels, 1 draw in 300 of the orientation property, with the reference sync). Pixels
@@ -216,6 +224,17 @@ def compare_silhouettes(ids_fury: np.ndarray, ids_pybullet: np.ndarray, *, min_p
             fury_only, bullet_only = rounded_slacks(int(max(fury[k], bullet[k])), rounding[k], slack, radii[k])
             contested |= differ & (((ids_fury == k) & (_near(ids_pybullet == k, fury_only) | _in_disc(discs[k], ids_fury.shape, slack)))
                                    | ((ids_pybullet == k) & _near(ids_fury == k, bullet_only)))
+    # Two bodies in contact share an outline where they meet and overlap: where one renderer draws the
+    # pair's edge with one body and the other with the other (interpenetrating discs of a chain, drawn in
+    # either order), a pixel of one body over background lies within the edge slack of its partner in the
+    # other picture. Measured: FURY 0.12's chain example kicked into a stack, a disc's rim 1-2 px below its
+    # partner's, 18 pixels off on a 91-pixel disc.
+    for i, j in touching or ():
+        for k, partner in ((i, j), (j, i)):
+            fury_only, bullet_only = rounded_slacks(int(max(fury[partner], bullet[partner])), rounding[partner], slack,
+                                                    radii[partner])
+            contested |= (ids_pybullet == k) & (ids_fury < 0) & _near(ids_fury == partner, bullet_only)
+            contested |= (ids_fury == k) & (ids_pybullet < 0) & _near(ids_pybullet == partner, fury_only)
     fury_ids = np.where(contested, -1, ids_fury)
     bullet_ids = np.where(contested, -1, ids_pybullet)
     fury = np.bincount(fury_ids.ravel() + 1, minlength=count + 1)[1:]
@@ -292,6 +311,26 @@ def projected_discs(scene, bindings: Sequence, camera, size) -> list[tuple[float
     for i, (column, row), d in zip(spheres, pixels, depth):
         if d > 0:
             found[i] = (float(column), float(row), float(bindings[i].shape.size[0] * per_metre / d))
+    return found
+
+
+def projected_radii(scene, bindings: Sequence, camera, size) -> list[float | None]:
+    """Each cylinder binding's radius on screen in pixels at its centre's depth (what scales its rim's
+    slack, :data:`ROUNDING`); None for other shapes (a sphere's is in :func:`projected_discs`)."""
+    from conformance import poses, truth
+
+    cylinders = [i for i, b in enumerate(bindings) if b.shape.kind == "cylinder"]
+    found: list[float | None] = [None] * len(bindings)
+    if not cylinders:
+        return found
+    positions, orientations = truth.link_frames(scene.p, [(bindings[i].body, bindings[i].link) for i in cylinders])
+    centres = np.array([poses.apply(pos, orn, [bindings[i].shape.position])[0]
+                        for i, pos, orn in zip(cylinders, positions, orientations)])
+    _, depth = projection.project(camera, size, centres)
+    per_metre = size[1] / 2 / math.tan(math.radians(camera.view_angle) / 2)
+    for i, d in zip(cylinders, depth):
+        if d > 0:
+            found[i] = float(bindings[i].shape.size[0] * per_metre / d)
     return found
 
 
