@@ -133,3 +133,43 @@ def test_a_sync_every_other_tick_is_named_skipped():
     recording = rec.recording([rec.box_frame()], [(positions, orientations)], [rec.track(vertices)])
     verdict = judge(recording, checks=("attached",))["attached"]
     assert not verdict.passed and verdict.diagnoses == ["skipped"], verdict.lines
+
+
+def test_actors_are_named_by_the_expression_that_reaches_them(monkeypatch):
+    """Actors kept in tuples inside a list, in a dict, or on an object of the app's own class are named as
+    the app reaches them (before: 'actor #N')."""
+    import sys
+    import types
+
+    from conformance.apps import driver
+
+    app = types.ModuleType("__main__")
+    actors = [object() for _ in range(6)]
+
+    class Robot:
+        def __init__(self):
+            self.parts = {"arm": actors[4]}
+
+    Robot.__module__ = "__main__"  # as a class of the app's script is (it runs as __main__)
+
+    app.rope_actor = actors[0]
+    app.links = [(actors[1], "link one"), (actors[2], "link two")]
+    app.by_name = {"ball": actors[3]}
+    app.robot = Robot()
+    app.alias = actors[0]  # a second, longer-to-sort name of the same actor: the first found stays
+    monkeypatch.setitem(sys.modules, "__main__", app)
+    names = driver._labels(actors)
+    assert [names.get(id(a)) for a in actors] == ["rope_actor", "links[0][0]", "links[1][0]", "by_name['ball']",
+                                                  "robot.parts['arm']", None]
+
+
+def test_a_body_left_unsynced_is_blamed_on_its_own_drawing_not_a_decoration_beside_it():
+    """A rope's last bead never synced, and a nail drawn (static) beside where the bead starts: ``drawn``
+    names the bead's actor, which has the bead's shape, not the nail (before: the first range near it)."""
+    positions, orientations = rec.motion()
+    start = np.broadcast_to(positions[:1], positions.shape), np.broadcast_to(orientations[:1], orientations.shape)
+    nail = np.array([[x, y, z] for x in (-0.01, 0.01) for y in (-0.01, 0.01) for z in (-0.05, 0.05)]) + [0.08, 0.0, 0.0]
+    tracks = [rec.track(rec.draw(*start, nail), label="nail_actor"), rec.track(rec.draw(*start), label="bead_actors[9]")]
+    verdict = judge(rec.recording([rec.box_frame()], [(positions, orientations)], tracks), checks=("attached", "drawn"))["drawn"]
+    assert not verdict.passed and "bead_actors[9] vertices 0:8 stays where it was built" in verdict.lines[0], verdict.lines
+    assert verdict.diagnoses == ["never-moved"]

@@ -89,24 +89,48 @@ class _TickFunction:
         return ""
 
 
+#: How deep and how wide :func:`_labels` looks for the app's actors among its module's values.
+LABEL_DEPTH = 3
+LABEL_BUDGET = 200_000
+
+
 def _labels(actors) -> dict[int, str]:
-    """Names the app's own module gives its actors (``rope_actor``, ``brick_actors[3]``), by ``id``."""
+    """Names the app's own module gives its actors, by ``id``: the shortest expression that reaches each
+    from a module-level name, through lists, tuples, dicts and plain objects' attributes, a few levels
+    deep (``rope_actor``, ``brick_actors[3]``, ``links[2][0]``, ``robot.parts['arm']``)."""
+    import inspect
+    import types
+
     main = sys.modules.get("__main__")
     names: dict[int, str] = {}
     wanted = {id(a) for a in actors}
-    for name, value in list(vars(main).items()) if main is not None else []:
-        if name.startswith("__"):
-            continue
-        if id(value) in wanted:
-            names.setdefault(id(value), name)
-        elif isinstance(value, (list, tuple)):
-            for i, item in enumerate(value[:100000]):
-                if id(item) in wanted:
-                    names.setdefault(id(item), f"{name}[{i}]")
-        elif isinstance(value, dict):
-            for key, item in list(value.items())[:100000]:
-                if id(item) in wanted:
-                    names.setdefault(id(item), f"{name}[{key!r}]")
+    if main is None:
+        return names
+    level = [(name, value) for name, value in list(vars(main).items()) if not name.startswith("__")]
+    seen: set[int] = set()
+    budget = LABEL_BUDGET
+    for _depth in range(LABEL_DEPTH + 1):
+        deeper = []
+        for expression, value in level:
+            if id(value) in wanted:
+                names.setdefault(id(value), expression)
+                continue  # an actor is a leaf: what it holds is not the app's naming
+            if id(value) in seen or budget <= 0:
+                continue
+            seen.add(id(value))
+            if isinstance(value, (list, tuple)):
+                items = [(f"{expression}[{i}]", item) for i, item in enumerate(value[:budget])]
+            elif isinstance(value, dict):
+                items = [(f"{expression}[{key!r}]", item) for key, item in list(value.items())[:budget]]
+            elif (hasattr(value, "__dict__") and not isinstance(value, (types.ModuleType, type))
+                  and not inspect.isroutine(value) and type(value).__module__ in (getattr(main, "__name__", ""), "__main__")):
+                items = [(f"{expression}.{key}", item) for key, item in list(vars(value).items())[:budget]
+                         if not key.startswith("_")]
+            else:
+                continue
+            budget -= len(items)
+            deeper.extend(items)
+        level = deeper
     return names
 
 

@@ -369,19 +369,29 @@ class _Judgement:
         return float(max(np.max(np.linalg.norm(p - p[0], axis=1)), np.max(turn) * radius))
 
     def _left_behind(self, index: int) -> str:
-        """An actor range held by the world that sits on this frame as it was at the start."""
-        radius = bounding_radius(self.r.frames[index].shapes)
+        """An actor range held by the world that sits on this frame as it was at the start: of several near
+        it, one that is the frame's shape there (its extents in the frame's axes), else the nearest (a nail
+        drawn beside the rope's last bead is not that bead)."""
+        info = self.r.frames[index]
+        radius = bounding_radius(info.shapes) if info.shapes else bounding_sphere(info.shapes, info.mesh)[1]
         # A frame that never moves holds what the world holds (a static ground plate): either may be named.
         still = [i for i, f in enumerate(self.r.frames) if self._movement(i, bounding_radius(f.shapes) if f.shapes else 0.0) == 0.0]
+        origin, turn = self.r.positions[0, index], _rotations(self.r.orientations[0, index])
+        found = []
         for track, a in zip(self.r.actors, self.attachments):
             world = np.flatnonzero(((a.frame < 0) | np.isin(a.frame, still)) & a.held)
             if not len(world):
                 continue
             for start, stop in _runs(np.isin(np.arange(len(a.frame)), world), a.frame):
-                centre = track.vertices[0, start:stop].mean(axis=0)
-                if np.linalg.norm(centre - self.r.positions[0, index]) <= radius + 0.01:
-                    return f"{track.label} vertices {start}:{stop}"
-        return ""
+                points = track.vertices[0, start:stop]
+                distance = float(np.linalg.norm(points.mean(axis=0) - origin))
+                if distance > radius + 0.01:
+                    continue
+                local = (points - origin) @ turn  # in the frame as it was at the start
+                placed = place(local, info.shapes, self._inertial(index), tolerance=self.tolerance, mesh=info.mesh,
+                               visuals=info.visuals)
+                found.append((not (placed.judged and placed.ok), distance, f"{track.label} vertices {start}:{stop}"))
+        return min(found)[2] if found else ""
 
     def placements(self) -> list:
         """``(track, attachment, frame, rows, Placement)`` of every actor's held vertices of every frame,
