@@ -21,7 +21,7 @@ from pathlib import Path
 
 from .timing import RatioToBaseline
 
-__all__ = ["AppFigure", "apps", "measure"]
+__all__ = ["AppFigure", "VerdictFigure", "apps", "measure", "verdict_cost", "verdict_pairs"]
 
 ROOT = Path(__file__).resolve().parent.parent
 TICKS = 60
@@ -82,3 +82,41 @@ def measure(name: str, script: Path, environment: dict, *, repeats: int, ticks: 
         if best is None or figure.ratio < best.ratio:
             best = figure
     return best
+
+
+@dataclass(frozen=True)
+class VerdictFigure(RatioToBaseline):
+    """A failing app's whole verdict (``seconds``) against a passing one of the same robot (``baseline``),
+    each ``python -m conformance app`` as a user runs it: the own run, then (passing) the perturbed runs,
+    or (failing) the diagnosis of what failed."""
+
+    name: str
+    seconds: float
+    baseline: float
+
+
+def verdict_pairs(backend: str) -> list[tuple[str, Path, Path]]:
+    """(name, right app, wrong app) of the robots whose verdicts are compared (issue 29: an ``attached``
+    failure on a 15-link robot cost 3 to 7 times a pass, most of it the diagnosis)."""
+    examples = ROOT / "examples" / backend
+    return [(f"KUKA iiwa, links read without computeForwardKinematics (`{backend}/wrong/kuka_no_forward_kinematics.py`) "
+             f"against `{backend}/kuka.py`", examples / "kuka.py", examples / "wrong" / "kuka_no_forward_kinematics.py"),
+            (f"R2-D2, welded links left unsynced (`{backend}/wrong/r2d2_welded_links_unsynced.py`) against "
+             f"`{backend}/r2d2.py`", examples / "r2d2.py", examples / "wrong" / "r2d2_welded_links_unsynced.py")]
+
+
+def verdict_cost(name: str, right: Path, wrong: Path, *, repeats: int) -> VerdictFigure:
+    """The best of ``repeats`` wall times of each verdict, one after the other in the same run."""
+    import subprocess
+    import sys
+
+    def timed(script: Path) -> float:
+        start = time.perf_counter()
+        subprocess.run([sys.executable, "-m", "conformance", "app", str(script)], capture_output=True, timeout=1800)
+        return time.perf_counter() - start
+
+    passing = failing = float("inf")
+    for _ in range(repeats):
+        passing = min(passing, timed(right))
+        failing = min(failing, timed(wrong))
+    return VerdictFigure(name, failing, passing)

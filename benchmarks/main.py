@@ -64,6 +64,7 @@ class Results:
     pictures: list = field(default_factory=list)
     suite: list = field(default_factory=list)
     apps: list = field(default_factory=list)
+    verdict_costs: list = field(default_factory=list)
     renderer: dict = field(default_factory=dict)
 
 
@@ -88,6 +89,9 @@ def _tasks(options: Options, results: Results) -> list[Callable[[], None]]:
         for name, script, environment in app_mode.apps(backends.NAME):
             tasks.append(lambda n=name, s=script, e=environment: results.apps.append(
                 app_mode.measure(n, s, e, repeats=min(options.repeats, 3))))
+        for name, right, wrong in app_mode.verdict_pairs(backends.NAME):
+            tasks.append(lambda n=name, r=right, w=wrong: results.verdict_costs.append(
+                app_mode.verdict_cost(n, r, w, repeats=min(options.repeats, 2))))
     if options.suite:
         runs = suite.commands(checks_only=options.suite == "checks")
         tasks.append(lambda: results.suite.extend(suite.measure(repeats=options.suite_repeats, baseline_repeats=3, runs=runs)))

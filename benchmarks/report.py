@@ -140,6 +140,11 @@ def markdown(results: Results) -> str:
         out += ["", f"**App mode** (`python -m conformance app`, {app_mode.TICKS} ticks, best of "
                 f"{min(o.repeats, 3)} runs), per tick, as a ratio to the app's own tick in the same run (its callbacks: "
                 "step, sync, render):", ""] + _apps_table(results)
+    if results.verdict_costs:
+        out += ["", f"**A failing robot's verdict** (`python -m conformance app`, best of {min(o.repeats, 2)}), as a ratio "
+                "to the passing verdict of the same robot in the same run (target: at most 2):", "",
+                "| failing app, against the passing one | failing | passing | ratio |", "|---|---|---|---|"]
+        out += [f"| {f.name} | {f.seconds:.1f} s | {f.baseline:.1f} s | {_ratio(f.ratio)} |" for f in results.verdict_costs]
     if results.suite:
         out += ["", f"**Whole runs** (subprocesses, best of {o.suite_repeats}), as a ratio to {suite.BASELINE}:", ""]
         out += _suite_table(results)
@@ -158,6 +163,7 @@ def as_json(results: Results) -> str:
         "targets": [v.as_dict() for v in results.verdicts],
         "reads": [f.as_dict() for f in results.reads],
         "pictures": [f.as_dict() for f in results.pictures],
+        "verdict_costs": [f.as_dict() for f in results.verdict_costs],
         "suite": [f.as_dict() for f in results.suite],
         "apps": [f.as_dict() for f in results.apps],
     }, indent=2)

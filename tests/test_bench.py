@@ -314,3 +314,17 @@ def test_app_mode_figures_are_per_tick_against_the_apps_own_tick():
     text = report.markdown(Results(options=Options(parts=()), machine=_machine(), started="now", apps=[figure]))
     assert "**App mode**" in text and "| boxes | 10 |" in text
     assert [name for name, _, _ in app_mode.apps(backends.NAME)][-1].startswith("1,000 boxes in one actor")
+
+
+def test_a_failing_robots_verdict_is_timed_against_the_passing_one():
+    """The figure is the failing verdict's wall time over the passing one's, measured in the same run; the
+    report says the target (issue 29: at most twice)."""
+    from benchmarks.app_mode import VerdictFigure
+
+    apps = Path(__file__).resolve().parent / "apps"
+    figure = app_mode.verdict_cost("box", apps / f"box_{backends.NAME}.py", apps / f"box_{backends.NAME}.py", repeats=1)
+    assert figure.seconds > 0 and figure.baseline > 0 and figure.ratio == figure.seconds / figure.baseline
+    text = report.markdown(Results(options=Options(parts=()), machine=_machine(), started="now",
+                                   verdict_costs=[VerdictFigure("a robot", 3.0, 2.0)]))
+    assert "**A failing robot's verdict**" in text and "| a robot | 3.0 s | 2.0 s | 1.5" in text
+    assert all(right.exists() and wrong.exists() for _, right, wrong in app_mode.verdict_pairs(backends.NAME))
