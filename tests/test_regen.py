@@ -81,6 +81,25 @@ def test_regen_failing_remakes_a_wrong_golden_and_says_by_how_much(made, capsys,
     assert png.read_bytes() == golden.paths(made, SCENE, 120)[0].read_bytes()
 
 
+def test_regen_after_a_camera_change_says_how_many_pixels_changed(copy, capsys):
+    """Issue 30, point 1: a golden made for another camera cannot be read as the scene's, so it was
+    replaced without being compared and regen said "pixels identical" (73,625 of 172,800 differed)."""
+    from PIL import Image
+
+    png, manifest_path = golden.paths(copy, SCENE, 120)
+    manifest = json.loads(manifest_path.read_text())
+    manifest["camera"]["position"] = [8.0, -6.0, 2.5]  # made with another camera
+    manifest_path.write_text(json.dumps(manifest))
+    picture = np.asarray(Image.open(png)).copy()
+    picture[10:20, 10:30] = (255, 0, 0)  # and so another picture: 200 pixels
+    png.write_bytes(files.encode_png(picture))
+    assert cli.main(["regen", SCENE, "--golden-dir", str(copy)]) == 0
+    out = capsys.readouterr().out
+    assert "free_fall frame 120: changed: 200 pixels differ" in out, out
+    assert "the old golden did not fit the scene: frame-0120.json was made for camera" in out, out
+    assert "pixels identical" not in out, out
+
+
 def _bumped(value, by):
     """Every float of a state moved by ``by`` (ids, names and the shape kept): another CPU's last bits."""
     if type(value) is float:

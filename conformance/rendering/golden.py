@@ -123,9 +123,11 @@ class Golden:
 
 
 def _unreadable(path: Path, scene: str, problem: str) -> GoldenUnreadable:
-    return GoldenUnreadable(f"golden {str(path)!r} of scene {scene!r} {problem}; nothing was compared and nothing "
+    error = GoldenUnreadable(f"golden {str(path)!r} of scene {scene!r} {problem}; nothing was compared and nothing "
                             f"was written. If the scene changed on purpose, make its goldens anew: "
                             f"{regen_command(scene, path.parent.parent)}")  # <dir>/<scene>/frame-NNNN.png
+    error.problem = f"{path.name} {problem}"  # what regen says it replaced, without the advice to regen
+    return error
 
 
 def _decode_png(path: Path, scene: str) -> np.ndarray:
@@ -145,6 +147,16 @@ def _decode_png(path: Path, scene: str) -> np.ndarray:
         raise _unreadable(path, scene, f"is not a PNG (its first bytes are {data[:8]!r})") from None
     except (OSError, SyntaxError, ValueError, zlib.error) as exc:
         raise _unreadable(path, scene, f"is damaged or truncated ({exc})") from None
+
+
+def picture_of(directory: Path | str, scene: str, frame: int) -> np.ndarray | None:
+    """The stored picture as it is, whatever its manifest says (None when there is none that decodes):
+    what regen compares a remade golden with when the old one no longer fits the scene."""
+    png, _ = paths(directory, scene, frame)
+    try:
+        return _decode_png(png, scene) if png.exists() else None
+    except GoldenError:
+        return None
 
 
 def read(directory: Path | str, scene: str, frame: int, *, params: dict[str, Any], camera: dict[str, Any],

@@ -161,6 +161,7 @@ class Change:
     largest: int = 0  # largest channel difference
     physics: str = ""  # the physics difference against the old manifest, if it had one
     state: str = ""  # the largest float difference of the states: the noise kept, or one beyond the bound
+    replaced: str = ""  # why the old golden could not be read as this scene's (another camera, a damaged file)
 
     def describe(self) -> str:
         where = f"{self.scene} frame {self.frame}"
@@ -170,10 +171,15 @@ class Change:
             return f"{where}: unchanged (byte-identical)"
         if self.status == "kept":
             return f"{where}: kept, not rewritten: same pixels, and the state differs only by float noise ({self.state})"
-        picture = (f"{self.pixels} pixels differ (largest channel difference {self.largest})" if self.pixels
-                   else "pixels identical")
+        if self.pixels < 0:
+            picture = "the old picture could not be decoded, so nothing was compared"
+        elif self.pixels:
+            picture = f"{self.pixels} pixels differ (largest channel difference {self.largest})"
+        else:
+            picture = "pixels identical"
         return (f"{where}: changed: {picture}" + (f"; physics: {self.physics}" if self.physics else "")
-                + (f"; state beyond float noise: {self.state}" if self.state else ""))
+                + (f"; state beyond float noise: {self.state}" if self.state else "")
+                + (f"; the old golden did not fit the scene: {self.replaced}" if self.replaced else ""))
 
 
 def only_float_noise(old: storage.Golden, image: np.ndarray, made: dict[str, Any]) -> state.FloatNoise | None:
@@ -203,11 +209,14 @@ def regenerate(scene_name: str, directory: Path | str, *, mode: str = "all", tol
     here = backends.renderer_info()
     spec = scenes.get(scene_name)
     for frame, image, made in make(scene_name):
+        replaced = ""
         try:
             old = storage.read(directory, scene_name, frame, params=dict(spec.defaults),
                                camera=spec.camera.as_dict(), size=tuple(spec.image_size))
-        except GoldenError:
+        except GoldenError as exc:
             old = None  # missing or unreadable: every mode makes it anew
+            replaced = getattr(exc, "problem", "")
+            before = storage.picture_of(directory, scene_name, frame)
         if old is not None and mode == "missing":
             continue
         if old is not None and mode == "failing":
@@ -226,7 +235,18 @@ def regenerate(scene_name: str, directory: Path | str, *, mode: str = "all", tol
             changes.append(Change(scene_name, frame, "unchanged"))
             continue
         if old is None:
-            changes.append(Change(scene_name, frame, "new" if not existed else "changed"))
+            if not existed:
+                changes.append(Change(scene_name, frame, "new"))
+                continue
+            # A golden made for another camera or size is replaced: say how many of its pixels changed,
+            # never "identical" for a picture that was not compared (a camera moved: 73,625 differed).
+            if before is None:
+                pixels, largest = -1, 0
+            elif before.shape == image.shape:
+                pixels, largest = images.difference(before, image)
+            else:
+                pixels, largest = image.shape[0] * image.shape[1], 255
+            changes.append(Change(scene_name, frame, "changed", pixels, largest, replaced=replaced))
             continue
         pixels, largest = images.difference(old.image, image) if old.image.shape == image.shape else (image.size // 3, 255)
         physics = state.compare(made["state"], old.state)
