@@ -106,10 +106,19 @@ def test_golden_physics(scene_name, pictures):
                           f"physics differs from the golden's stored state, {v.difference.describe()}; its picture "
                           "verdicts restore the stored state and stay valid")
     if failed:
+        from conformance import own_scenes
+        from conformance.rendering import golden
+
+        # A user's scene most likely changed itself (a body moved, a mass changed); the kit's scenes are
+        # fixed, so for them the difference is pyBullet's or the platform's.
+        source = own_scenes.source_of(scene_name)
+        cause = (f"the scene changed (its populate in {own_scenes.scene_arguments(scene_name)[1]}), or pyBullet or the "
+                 "platform did. If you changed the scene on purpose" if source is not None else
+                 "this is pyBullet or the platform. If pyBullet changed on purpose")
+        command = golden.regen_command(scene_name, pictures.golden_dir_for(scene_name))
         pytest.fail("\n".join(f"physics differs from the golden's stored state at {scene_name} frame {v.frame}: "
                               f"{v.difference.describe()}. The picture verdicts are unaffected (they restore the stored "
-                              "state); this is pyBullet or the platform. If pyBullet changed on purpose: "
-                              f"python -m conformance regen {scene_name}" for v in failed), pytrace=False)
+                              f"state); {cause}, make its goldens anew: {command}" for v in failed), pytrace=False)
 
 
 def test_no_stale_goldens(pictures):

@@ -102,6 +102,30 @@ def test_a_failing_check_reproduces_as_printed_from_the_same_directory(project):
     assert replay.returncode == 1 and "FAIL tossed_die" in replay.stdout, replay.stdout + replay.stderr
 
 
+def test_a_changed_scene_s_physics_failure_blames_the_scene_and_its_command_runs(project, tmp_path):
+    """Issue 30, point 2: it said "this is pyBullet or the platform" and printed a regen command
+    without ``--scenes``, which failed with "scene='tossed_die', but should be one of: ..."."""
+    import shutil
+
+    moved = tmp_path / "moved"
+    shutil.copytree(project, moved)
+    source = (moved / "my_scenes.py").read_text(encoding="utf-8")
+    (moved / "my_scenes.py").write_text(source.replace("position=(-0.3, 0, 0.6)", "position=(-0.3, 0, 0.65)"),
+                                        encoding="utf-8")  # the user moved the die 5 cm up
+    run = _run(moved, "-m", "pytest", "--pyargs", "conformance", "-p", "no:cacheprovider", "-q",
+               "--conformance-scenes", "my_scenes.py", "-k", "test_golden_physics and tossed_die")
+    assert run.returncode == 1, run.stdout[-2000:]
+    assert "the scene changed (its populate in my_scenes.py)" in run.stdout, run.stdout[-2000:]
+    assert "this is pyBullet or the platform" not in run.stdout
+    command = re.search(r"make its goldens anew: (python -m conformance regen .*)", run.stdout).group(1)
+    assert shlex.split(command) == ["python", "-m", "conformance", "regen", "tossed_die", "--scenes", "my_scenes.py"]
+    made = _run(moved, *shlex.split(command)[1:])  # run as printed, from where the user ran
+    assert made.returncode == 0, made.stdout + made.stderr
+    again = _run(moved, "-m", "pytest", "--pyargs", "conformance", "-p", "no:cacheprovider", "-q",
+                 "--conformance-scenes", "my_scenes.py", "-k", "test_golden_physics and tossed_die")
+    assert again.returncode == 0, again.stdout[-2000:]
+
+
 @pytest.mark.parametrize("content, message", [
     (None, r"scene source 'absent.py': .*absent.py is not a file"),
     ("x = 1\n", r"defines no SceneSpec; give it one at module level"),
