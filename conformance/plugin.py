@@ -85,9 +85,10 @@ def pytest_addoption(parser: pytest.Parser) -> None:
     group.addoption("--conformance-app-ticks", dest="conformance_app_ticks", default=None, metavar="N",
                     help="ticks of each app's own run (default 120)")
     parser.addini("conformance_app_ticks", "default for --conformance-app-ticks", default=None)
-    group.addoption("--conformance-scenes", dest="conformance_scenes", action="append", default=None, metavar="SOURCE",
-                    help="a .py file or module of your own scenes (SceneSpec objects), checked beside the kit's; "
-                    "repeatable, added to the ini conformance_scenes and $CONFORMANCE_SCENES")
+    group.addoption("--conformance-scenes", "--scenes", dest="conformance_scenes", action="append", default=None, metavar="SOURCE",
+                    help="a .py file or module of your own scenes (SceneSpec objects), checked beside the kit's "
+                    "(also spelled --scenes, as python -m conformance spells it); repeatable, added to the ini "
+                    "conformance_scenes and $CONFORMANCE_SCENES")
     parser.addini("conformance_scenes", "your own scene sources (.py files relative to the ini file, or modules), "
                   "one per line", type="linelist", default=[])
     from conformance import image_options

@@ -76,6 +76,15 @@ def test_one_run_checks_the_kit_s_scenes_and_yours_each_against_its_own_goldens(
     assert verdicts == {"free_fall": "PASS", "tossed_die": "PASS"}, run.stdout[-2000:]
 
 
+def test_pytest_takes_scenes_as_python_m_conformance_spells_it(project):
+    """Issue 30, point 4: the README says "add --scenes my_scenes.py to any command"; pytest answered
+    "unrecognized arguments: --scenes"."""
+    run = _run(project, "-m", "pytest", "--pyargs", "conformance", "-p", "no:cacheprovider", "-q",
+               "--scenes", "my_scenes.py", "-k", "test_golden_physics and tossed_die")
+    assert run.returncode == 0, run.stdout[-2000:] + run.stderr[-2000:]
+    assert "1 passed" in run.stdout, run.stdout[-2000:]
+
+
 def test_a_missing_golden_names_the_whole_command_that_makes_it(project, tmp_path):
     run = _run(project, "-m", "pytest", "--pyargs", "conformance", "-p", "no:cacheprovider", "-q",
                "--conformance-scenes", "my_scenes.py", "-k", "test_golden_physics and tossed_die",
