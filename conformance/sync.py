@@ -179,6 +179,11 @@ def load(spec: str) -> SyncImplementation:
         module = importlib.import_module(module_name)
     except Exception as exc:
         hint = " Is it on PYTHONPATH, or in the directory you run from?" if isinstance(exc, ModuleNotFoundError) else ""
+        if module_name.endswith(".py") or "/" in module_name or os.sep in module_name:
+            # --scenes takes a file's path; --sync takes a module's name, as Python imports it.
+            dotted = module_name.removesuffix(".py").replace(os.sep, ".").replace("/", ".").strip(".")
+            hint = (f" --sync takes a module's dotted name, not a file's path: "
+                    f"'{dotted}:{attribute}', run from the directory that holds {module_name.split('/')[0]!r}.")
         raise SyncLoadError(
             f"sync implementation {spec!r}: importing module {module_name!r} failed with "
             f"{_exception_line(exc)}{_user_location(exc)}.{hint}"

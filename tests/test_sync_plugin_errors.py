@@ -37,6 +37,8 @@ def _assert_clean_usage_error(result, *needles: str) -> None:
         ("no_colon_here", ["'no_colon_here' is neither a short name", "module:attribute"]),
         ("no_such_module_xyz:Sync", ["importing module 'no_such_module_xyz' failed", "ModuleNotFoundError", "PYTHONPATH"]),
         (":Sync", ["neither a short name"]),
+        # Issue 30, point 10: a path, as --scenes takes, said only "No module named 'mysim/sync'".
+        ("mysim/sync.py:MySync", ["not a file's path: 'mysim.sync:MySync'", "the directory that holds 'mysim'"]),
     ],
 )
 def test_unloadable_spec_is_a_usage_error(pytester, spec, needles):
