@@ -295,9 +295,17 @@ def pytest_report_header(config: pytest.Config) -> list[str]:
         backend = backends.describe()
     except BackendError as exc:
         backend = f"no backend: {exc}"
+    try:
+        apps = app_paths(config)
+    except pytest.UsageError:
+        apps = []  # said once, where the apps are collected
+    # The sync is what the scenes' checks run; an app is judged on its own code, whatever --sync says.
+    judged = (f"sync {_sync_spec(config)!r} in the scenes' checks; apps (their own code): "
+              + ", ".join(p.name for p in apps[:4]) + (f" and {len(apps) - 4} more" if len(apps) > 4 else "")
+              if apps else f"sync {_sync_spec(config)!r}")
     return [
         f"conformance: {backend}",
-        f"conformance: sync {_sync_spec(config)!r}; {profiles.describe()}; tolerance {tolerance_from(config).describe()}",
+        f"conformance: {judged}; {profiles.describe()}; tolerance {tolerance_from(config).describe()}",
         "conformance: " + ", ".join(versions),
         "conformance: " + image_options.from_config(config).describe(),
     ]

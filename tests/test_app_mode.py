@@ -164,6 +164,14 @@ def test_apps_in_the_ini_are_checked_one_id_per_check(pytester):
     result.stdout.fnmatch_lines(["*PASS  app:app.py*"])
 
 
+def test_the_header_of_a_run_with_apps_says_the_apps_are_judged_on_their_own_code(pytester):
+    """Issue 30, point 10: a run checking an app said only "sync 'reference'" in its header."""
+    pytester.makefile(".py", app=SOURCE)
+    result = pytester.runpytest_subprocess("--pyargs", "conformance.test_apps", "-p", "no:cacheprovider",
+                                           "--conformance-app", "app.py", "--collect-only")
+    result.stdout.fnmatch_lines(["conformance: sync 'reference' in the scenes' checks; apps (their own code): app.py; *"])
+
+
 def test_a_missing_app_is_a_usage_error(pytester):
     result = pytester.runpytest_subprocess("--pyargs", "conformance.test_apps", "--conformance-app", "nowhere.py")
     assert result.ret == pytest.ExitCode.USAGE_ERROR
