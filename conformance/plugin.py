@@ -383,6 +383,13 @@ def kit(request: pytest.FixtureRequest, sync_implementation):
 _FIGURES = pytest.StashKey[dict]()
 
 
+def _is_the_kits(item: pytest.Item) -> bool:
+    """Whether ``item`` is one of the kit's checks (a file of this package), not a test of the user's."""
+    from pathlib import Path
+
+    return Path(__file__).resolve().parent in Path(str(item.path)).resolve().parents
+
+
 @pytest.hookimpl(wrapper=True)
 def pytest_runtest_call(item: pytest.Item):
     from conformance import figures
@@ -392,10 +399,15 @@ def pytest_runtest_call(item: pytest.Item):
         return (yield)
 
 
-@pytest.hookimpl(wrapper=True)
+@pytest.hookimpl(wrapper=True, tryfirst=True)  # outermost: after Hypothesis' wrapper has added its patch
 def pytest_runtest_makereport(item: pytest.Item, call):
     report = yield
     from conformance import survey
+
+    if _is_the_kits(item):
+        # Hypothesis offers a patch "to add failing test cases to your code" for every failing draw, even
+        # an expected failure's: here it would edit the kit's installed files, not the user's code.
+        report.__dict__.pop("_hypothesis_failing_examples", None)
     from conformance.rendering.records import GOLDEN_VERDICTS
 
     _only_the_paragraph(call, report)

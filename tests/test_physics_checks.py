@@ -338,3 +338,19 @@ def test_a_listed_deviation_that_goes_away_fails_the_run(pytester):
     result = pytester.runpytest("-p", "no:cacheprovider", "-rX")
     result.assert_outcomes(failed=1, passed=1)
     result.stdout.fnmatch_lines(["*XPASS(strict)*default-collision-filter-mode*"])
+
+
+def test_an_expected_failure_offers_no_patch_to_the_kit_s_own_files(tmp_path):
+    """Issue 30, point 8: an all-pass run printed Hypothesis' "`git apply .hypothesis/patches/….patch` to
+    add failing test cases to your code" for the draws of the xfailed deviations: a patch of the kit's
+    installed files, not of the user's code."""
+    import subprocess
+    import sys
+
+    from conformance.display import child_environment
+
+    run = subprocess.run([sys.executable, "-m", "pytest", "--pyargs", "conformance", "-p", "no:cacheprovider",
+                          "-k", "test_default_filter_mode_is_and"], cwd=tmp_path, capture_output=True, text=True,
+                         env=child_environment())
+    assert run.returncode == 0 and "1 xfailed" in run.stdout, run.stdout[-2000:] + run.stderr[-2000:]
+    assert "git apply" not in run.stdout and not (tmp_path / ".hypothesis" / "patches").exists(), run.stdout[-2000:]
