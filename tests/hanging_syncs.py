@@ -41,3 +41,15 @@ class InterruptedOnFreeFall(MisbehavesOnFreeFall):
 
     def misbehave(self):
         raise KeyboardInterrupt
+
+
+class CtrlCOnFreeFall(MisbehavesOnFreeFall):
+    """Presses Ctrl-C at that call: SIGINT to its whole process group, as a terminal sends it to the
+    command in the foreground and everything it started (``tests/test_kit_interrupt.py``)."""
+
+    def misbehave(self):
+        import os
+        import signal
+
+        os.killpg(os.getpgrp(), signal.SIGINT)
+        time.sleep(5)  # the signal arrives here, as a KeyboardInterrupt

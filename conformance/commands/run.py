@@ -30,4 +30,19 @@ def run(args, extra: list[str]) -> int:
     # However this process ends (SIGTERM from a cancelled CI job, SIGKILL, Ctrl-C), pytest gets
     # SIGTERM and stops its display on the way out: nothing is left running.
     with subprocess.Popen(argv, preexec_fn=dies_with_this_process()) as pytest_run:
-        return pytest_run.wait()
+        return _wait_through_ctrl_c(pytest_run)
+
+
+def _wait_through_ctrl_c(child: subprocess.Popen) -> int:
+    """The child's exit status. Ctrl-C reaches the child too (the terminal signals the whole foreground
+    group), and pytest answers it with its summary and the per-scene table: this process waits for
+    that instead of dying with a traceback and taking the child down mid-sentence. A second Ctrl-C
+    stops the child at once."""
+    interrupted = False
+    while True:
+        try:
+            return child.wait()
+        except KeyboardInterrupt:
+            if interrupted:
+                child.terminate()
+            interrupted = True
