@@ -52,3 +52,29 @@ def test_a_library_not_listed_is_missing(tmp_path):
     assert "libvulkan1" in _missing(tmp_path, "pygfx")
     _fake_ldconfig(tmp_path, [name for name in LIBRARIES if name != "libXt.so.6"])
     assert "libxt6" in _missing(tmp_path, "vtk")
+
+
+def _fake_python3(directory: Path, fury: str | None) -> None:
+    """A ``python3`` whose installed FURY is ``fury`` (None: none); anything else goes to the real one."""
+    real = subprocess.run(["bash", "-c", "command -v python3"], capture_output=True, text=True).stdout.strip()
+    answer = f'echo {fury}; exit 0' if fury else 'exit 1'
+    script = directory / "python3"
+    script.write_text("#!/usr/bin/env bash\n"
+                      f'case "$*" in *importlib.metadata*) {answer} ;; esac\n'
+                      f'exec {real} "$@"\n')
+    script.chmod(script.stat().st_mode | stat.S_IEXEC)
+
+
+@pytest.mark.parametrize("fury, backend", [("2.0.0", "pygfx"), ("0.12.0", "vtk"), ("2.1.0", "fury21")])
+def test_without_backend_the_kit_follows_the_fury_you_have(tmp_path, fury, backend):
+    """Issue 30, point 6: ``./kit run`` meant FURY 0.12 whatever the user had; it follows the FURY of
+    the python3 it is called with, and says so with how to choose the other."""
+    _fake_python3(tmp_path, fury)
+    env = {k: v for k, v in os.environ.items() if k != "KIT_BACKEND"}
+    env["PATH"] = f"{tmp_path}{os.pathsep}{os.environ['PATH']}"
+    env["KIT_PYTHON"] = subprocess.run(["bash", "-c", "command -v python3"], capture_output=True, text=True).stdout.strip()
+    done = subprocess.run([str(KIT), "missing"], env=env, capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr
+    assert f"kit: backend {backend} (your python3 has FURY {fury};" in done.stderr, done.stderr
+    given = subprocess.run([str(KIT), "missing", "--backend", "vtk"], env=env, capture_output=True, text=True, timeout=60)
+    assert "kit: backend" not in given.stderr, given.stderr  # a backend given is not second-guessed
