@@ -52,7 +52,10 @@ def _goldens(pictures, scene, params=None):
         return {frame: snapshots.load(pictures.golden_dir_for(scene.name), scene, frame, params=params)
                 for frame in scenes.get(scene.name).frames_with_goldens()}
     except GoldenError as err:
-        pytest.fail(str(err), pytrace=False)
+        problem = str(err)
+    # Failed outside the except: inside, pytest printed the paragraph twice, joined by "During handling
+    # of the above exception, another exception occurred".
+    pytest.fail(problem, pytrace=False)
 
 
 @each_golden_variant()

@@ -135,6 +135,24 @@ def test_a_changed_scene_s_physics_failure_blames_the_scene_and_its_command_runs
     assert again.returncode == 0, again.stdout[-2000:]
 
 
+def test_a_golden_made_for_another_camera_is_said_once_naming_what_changed(project, tmp_path):
+    """Issue 30, point 9: after a camera change the paragraph was printed twice, joined by "During
+    handling of the above exception, another exception occurred", with both whole cameras."""
+    import shutil
+
+    moved = tmp_path / "camera"
+    shutil.copytree(project, moved)
+    source = (moved / "my_scenes.py").read_text(encoding="utf-8")
+    (moved / "my_scenes.py").write_text(source.replace("Camera((0.0, -2.5, 1.2)", "Camera((0.0, -2.0, 1.2)"),
+                                        encoding="utf-8")
+    run = _run(moved, "-m", "pytest", "--pyargs", "conformance", "-p", "no:cacheprovider", "-q",
+               "--scenes", "my_scenes.py", "-k", "test_golden_physics and tossed_die")
+    assert run.returncode == 1, run.stdout[-2000:]
+    assert "During handling" not in run.stdout, run.stdout[-3000:]
+    assert run.stdout.count("was made for camera position [0.0, -2.5, 1.2], but the check renders camera "
+                            "position [0.0, -2.0, 1.2]") == 1, run.stdout[-3000:]
+
+
 @pytest.mark.parametrize("content, message", [
     (None, r"scene source 'absent.py': .*absent.py is not a file"),
     ("x = 1\n", r"defines no SceneSpec; give it one at module level"),

@@ -149,6 +149,15 @@ def _decode_png(path: Path, scene: str) -> np.ndarray:
         raise _unreadable(path, scene, f"is damaged or truncated ({exc})") from None
 
 
+def _made_for(key: str, made: Any, wanted: Any) -> str:
+    """How the golden's ``key`` differs from what the check renders: only the entries that differ."""
+    if isinstance(made, dict) and isinstance(wanted, dict):
+        differ = sorted(k for k in set(made) | set(wanted) if made.get(k) != wanted.get(k))
+        return (f"was made for {key} " + ", ".join(f"{k} {made.get(k)!r}" for k in differ)
+                + f", but the check renders {key} " + ", ".join(f"{k} {wanted.get(k)!r}" for k in differ))
+    return f"was made for {key} {made!r}, but the check renders {key} {wanted!r}"
+
+
 def picture_of(directory: Path | str, scene: str, frame: int) -> np.ndarray | None:
     """The stored picture as it is, whatever its manifest says (None when there is none that decodes):
     what regen compares a remade golden with when the old one no longer fits the scene."""
@@ -181,8 +190,7 @@ def read(directory: Path | str, scene: str, frame: int, *, params: dict[str, Any
                 "size": list(size)}
     for key, value in expected.items():
         if manifest[key] != value:
-            raise _unreadable(manifest_path, scene, f"was made for {key} {manifest[key]!r}, but the check renders "
-                                                     f"{key} {value!r}")
+            raise _unreadable(manifest_path, scene, _made_for(key, manifest[key], value))
     image = _decode_png(png, scene)
     if image.shape[:2] != (size[1], size[0]):
         raise _unreadable(png, scene, f"is {image.shape[1]}x{image.shape[0]} pixels, but the scene renders "
