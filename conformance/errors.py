@@ -13,6 +13,7 @@ __all__ = [
     "ConformanceError",
     "DisplayUnavailable",
     "GoldenError",
+    "GoldenFramesBadly",
     "GoldenMissing",
     "GoldenUnreadable",
     "ImageSizeMismatch",
@@ -93,6 +94,11 @@ class GoldenMissing(GoldenError):
 class GoldenUnreadable(GoldenError):
     """A golden is not a PNG, is truncated, has the wrong size, or its manifest is malformed or was
     made for other scene parameters, another frame, or another camera."""
+
+
+class GoldenFramesBadly(GoldenError):
+    """``regen`` was asked for goldens of a scene whose camera cuts a body off, or shows one as a dot:
+    such a picture passes whatever the sync does to that body, so none is made."""
 
 
 class ImageSizeMismatch(GoldenError):

@@ -67,7 +67,14 @@ def test_golden_render(scene_name, variant, kit, pictures, request):
     from conformance.rendering import reftest, snapshots
 
     if pictures.regen and not variant:  # a variant has no goldens of its own to make
-        pictures.note_regenerated(request.node, snapshots.regenerate(scene_name, pictures.golden_dir_for(scene_name)))
+        try:
+            pictures.note_regenerated(request.node, snapshots.regenerate(scene_name, pictures.golden_dir_for(scene_name)))
+        except GoldenError as err:
+            refused = str(err)
+        else:
+            refused = ""
+        if refused:
+            pytest.fail(refused, pytrace=False)
     with kit.run(scene_name, **variant) as run:
         goldens = _goldens(pictures, run.scene, scenes.get(scene_name).defaults)
         physics = {v.frame: v for v in snapshots.check_physics(scene_name, goldens)}

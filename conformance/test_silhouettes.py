@@ -18,16 +18,6 @@ from conformance.profiles import check_settings
 from conformance.pytest_helpers import _context, each_scene, reproduce_command
 from conformance.rendering import framing, golden, silhouettes
 
-#: Targets the framing check excuses, and why.
-FRAMING_EXCEPTIONS = {
-    # Placed 50 m away on purpose, to test precision far from the origin; no camera shows both.
-    "tumbling": {"may_leave": {"far_box"}},
-    # The rope's pin, a 2 cm box hidden by the first disc / link: a dot at any camera showing the rope.
-    "chain": {"may_be_small": {"hinge"}},
-    "wrecking_ball": {"may_be_small": {"hinge"}},
-}
-
-
 def silhouette_check(run, sync: str, pictures=None, nodeid: str = ""):
     """FURY's ID render against pyBullet's mask for the run's current frame, as an ImageCheck (kept,
     with its masks when it failed, in the results directory when ``pictures`` is given)."""
@@ -105,14 +95,17 @@ def test_scene_camera_frames_every_body(scene_name, pictures, request):
         camera, size = run.scene.camera, run.scene.image_size
         for frame in scenes.get(scene_name).frames_with_goldens():
             run.advance(frame - run.frame)
-            record = framing.framing(run.drawing, camera, size, scene=scene_name, frame=frame,
-                                     **FRAMING_EXCEPTIONS.get(scene_name, {}))
+            record = framing.of_scene(run.drawing, camera, size, scene=scene_name, frame=frame)
             record.sync, record.nodeid = "reference", request.node.nodeid
             picture = backends.render(run.drawing, camera, size)
             if record.passed and (picture == picture[0, 0]).all():
                 record.passed, record.message = False, f"{scene_name} frame {frame}: the picture is blank"
             pictures.keep(record, {"actual": picture})
-            assert record.passed, record.message
+            if not record.passed:
+                pytest.fail(f"{record.message}. Move the scene's camera (its SceneSpec's Camera: position, focal "
+                            "point, view angle, clipping range) until every body is inside the picture, then make its "
+                            f"goldens anew: {golden.regen_command(scene_name, pictures.golden_dir_for(scene_name))}",
+                            pytrace=False)
 
 
 #: Scenes whose bodies are large on screen and free to turn: where a turn shows in a silhouette.

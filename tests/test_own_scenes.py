@@ -153,6 +153,29 @@ def test_a_golden_made_for_another_camera_is_said_once_naming_what_changed(proje
                             "position [0.0, -2.0, 1.2]") == 1, run.stdout[-3000:]
 
 
+def test_regen_refuses_a_camera_that_cuts_a_body_off(project, tmp_path):
+    """Issue 30, point 9: regen made goldens of a camera that cut the die off; only the next run's
+    framing check said so, as an ``assert False`` traceback of the kit's source."""
+    import shutil
+
+    moved = tmp_path / "close"
+    shutil.copytree(project, moved)
+    before = {p: p.read_bytes() for p in (moved / "golden").rglob("*") if p.is_file()}
+    source = (moved / "my_scenes.py").read_text(encoding="utf-8")
+    (moved / "my_scenes.py").write_text(source.replace("Camera((0.0, -2.5, 1.2)", "Camera((0.0, -0.6, 0.3)"),
+                                        encoding="utf-8")
+    made = _run(moved, "-m", "conformance", "regen", "tossed_die", "--scenes", "my_scenes.py")
+    assert made.returncode == 2, made.stdout + made.stderr
+    assert "no golden made, the camera frames it badly" in made.stderr and "'die': " in made.stderr, made.stderr
+    assert "Traceback" not in made.stderr
+    assert {p: p.read_bytes() for p in (moved / "golden").rglob("*") if p.is_file()} == before  # nothing written
+    framed = _run(moved, "-m", "pytest", "--pyargs", "conformance", "-p", "no:cacheprovider", "-q",
+                  "--scenes", "my_scenes.py", "-k", "test_scene_camera_frames_every_body and tossed_die")
+    assert framed.returncode == 1, framed.stdout[-2000:]
+    assert "badly framed" in framed.stdout and "Move the scene's camera" in framed.stdout, framed.stdout[-2000:]
+    assert "assert False" not in framed.stdout and "where False" not in framed.stdout, framed.stdout[-2000:]
+
+
 @pytest.mark.parametrize("content, message", [
     (None, r"scene source 'absent.py': .*absent.py is not a file"),
     ("x = 1\n", r"defines no SceneSpec; give it one at module level"),

@@ -27,7 +27,8 @@ from typing import Any
 import numpy as np
 
 from conformance import backends, state
-from conformance.errors import GoldenError
+from conformance.errors import GoldenError, GoldenFramesBadly
+from conformance.rendering import framing
 from conformance.rendering import golden as storage
 from conformance.rendering.records import ImageCheck
 
@@ -68,12 +69,21 @@ def make(scene_name: str) -> list[tuple[int, np.ndarray, dict[str, Any]]]:
 
     wanted = sorted(set(scenes.get(scene_name).frames_with_goldens()))
     renderer = backends.renderer_info()
-    made = []
+    made, framed = [], []
     with runner.running(scene_name, sync.load(GOLDEN_SYNC)) as run:
         for frame in wanted:
             run.advance(frame - run.frame)
+            framed.append(framing.of_scene(run.drawing, run.scene.camera, run.scene.image_size, scene=scene_name, frame=frame))
             image = backends.render(run.drawing, run.scene.camera, run.scene.image_size)
             made.append((frame, image, manifest(run, frame, state.capture(run.scene), renderer)))
+    badly = [record for record in framed if not record.passed]
+    if badly:  # refused before anything is written: the next run's framing check would fail on them
+        raise GoldenFramesBadly(
+            f"scene {scene_name!r}: no golden made, the camera frames it badly: {badly[0].message}"
+            + (f" (and at {len(badly) - 1} more golden frame(s))" if len(badly) > 1 else "")
+            + ". A body cut off or a few pixels across passes any picture check whatever the sync does to it. "
+            "Move the scene's camera (its SceneSpec's Camera: position, focal point, view angle, clipping range) "
+            "until every body is inside the picture, and regenerate.")
     return made
 
 
