@@ -81,10 +81,16 @@ def test_golden_render(scene_name, variant, kit, pictures, request):
         drawn = {frame: snapshots.draw(run, golden) for frame, golden in goldens.items()}
     # Drawn after the sync's run is closed: one live scene at a time, as an application has.
     references = reftest.references(scene_name, goldens, variant)
-    failures = []
+    failures, blamed = [], []
     for frame, golden in goldens.items():
         record, images = reftest.judge(golden, drawn[frame], references[frame], here=pictures.renderer,
                                        override=pictures.override, sync=kit.sync)
+        if "difference" in images and not blamed:  # the sync's verdict failed: name the bodies, once
+            from conformance.pytest_helpers import reproduce_command
+
+            blamed = [f"{reftest.bodies_where_pixels_differ(scene_name, golden, variant, references[frame], drawn[frame])}"
+                      f" [{scene_name}, frame {frame}]; the mistake, frame by frame: "
+                      f"{reproduce_command(scene_name, kit.sync, max(frame, 1), variant)}"]
         record.details["physics"] = physics[frame].as_dict()
         record.reproduce = _reproduce("test_golden_render", scene_name, kit.sync, variant)
         record.nodeid = request.node.nodeid
@@ -97,6 +103,7 @@ def test_golden_render(scene_name, variant, kit, pictures, request):
         # Each frame's two verdicts, the failed one first: what the sync did apart from what the renderer did.
         lines = [f"{line} [{where}, frame {r.frame}, sync {kit.sync!r}]" for r in failures
                  for line in sorted(r.message.splitlines(), key=lambda line: " FAIL: " not in line)]
+        lines += blamed
         lines.append(f"pictures: {pictures.results} (report.html); reproduce: {failures[0].reproduce}")
         pytest.fail("\n".join(lines), pytrace=False)
 

@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import dataclasses
 import os
+import re
+import shlex
 import subprocess
 import sys
 from pathlib import Path
@@ -142,6 +144,15 @@ def test_image_checks_alone_fail_a_wrong_sync_end_to_end(tmp_path):
     assert run.returncode == 1, run.stdout[-3000:] + run.stderr[-2000:]
     assert "test_golden_render[brick_wall_single]" in run.stdout and "frame 65" in run.stdout
     assert "test_vertices" not in run.stdout  # it is the image checks that caught it
+    # Issue 30, point 5: the golden failure names the bodies whose pixels differ and the command that
+    # names the mistake (it said only "12514 px differ, 39 allowed").
+    named = re.search(r"where the pixels differ, pyBullet's poses put '(brick_\d+|ball)' \(\d+ px\).*?"
+                      r"the mistake, frame by frame: (python -m conformance check brick_wall_single .*)", run.stdout)
+    assert named, run.stdout[-3000:]
+    replay = subprocess.run([sys.executable, *shlex.split(named.group(2))[1:]], cwd=tmp_path, env=env,
+                            capture_output=True, text=True, timeout=600)
+    assert replay.returncode == 1 and "diagnosis: a change never announced to the renderer" in replay.stdout, \
+        replay.stdout[-2000:] + replay.stderr[-2000:]
     pictures = sorted(p.name for p in (results / "golden" / "brick_wall_single").glob("*.png"))
     assert any(name.endswith("-difference.png") for name in pictures), pictures
     page = (results / "report.html").read_text(encoding="utf-8")

@@ -151,3 +151,31 @@ def judge(golden: storage.Golden, actual: np.ndarray, reference: np.ndarray, *, 
     if not verdicts[1].passed:
         pictures["reference_difference"] = compare.difference_image(golden.image, reference)
     return record, pictures
+
+
+def bodies_where_pixels_differ(scene_name: str, golden: storage.Golden, variant: Mapping[str, Any] | None,
+                               reference: np.ndarray, actual: np.ndarray, *, most: int = 5) -> str:
+    """Who a failed sync verdict is about: each pixel where the sync's picture differs from the live
+    reference's, named by the body pyBullet's pose puts there (the reference's drawing of the golden's
+    state, rendered with one id per target). A body drawn where it is not, or not redrawn, shows as its
+    name; pixels where pyBullet puts no body are something drawn where nothing is. One more scene built
+    and one id picture: made only for a failure."""
+    from conformance import backends, runner, scenes, state, sync
+
+    defaults = scenes.get(scene_name).defaults
+    variant = {k: v for k, v in (variant or {}).items() if k not in defaults or defaults[k] != v}
+    with runner.running(scene_name, sync.load(REFERENCE_SYNC), **variant) as run:
+        state.restore(run.scene, golden.state)
+        run.frame = golden.manifest["frame"]
+        run.sync()
+        ids = backends.render_ids(run.drawing, run.scene.camera, run.scene.image_size)
+        names = [t.name for t in run.drawing.targets]
+    differ = np.abs(reference.astype(np.int16) - actual.astype(np.int16)).max(axis=-1) > compare.SAME_RENDERER.pixel_threshold
+    counts = np.bincount(ids[differ] + 1, minlength=len(names) + 1)
+    named = sorted(((int(n), names[i]) for i, n in enumerate(counts[1:]) if n), reverse=True)
+    parts = [f"{name!r} ({n} px)" for n, name in named[:most]]
+    if len(named) > most:
+        parts.append(f"{len(named) - most} more bodies ({sum(n for n, _ in named[most:])} px)")
+    if counts[0]:
+        parts.append(f"no body ({int(counts[0])} px: drawn where pyBullet has nothing)")
+    return "where the pixels differ, pyBullet's poses put " + (", ".join(parts) if parts else "nothing")
