@@ -35,14 +35,23 @@ from conformance.errors import GoldenError
 from conformance.pytest_helpers import each_golden_variant, each_scene, variant_id
 
 
-def _reproduce(check: str, scene: str, sync: str, variant: dict | None = None) -> str:
+def _reproduce(check: str, scene: str, sync: str, variant: dict | None = None, pictures=None) -> str:
+    """The pytest command that runs this check again, with the options of this run that change its
+    verdict: the user's scenes, and the golden directory and image tolerance given."""
+    import os
+
     from conformance import own_scenes
 
     source = own_scenes.scene_arguments(scene)[1:]
     # The whole id, brackets included: "mixed_shapes" alone would select its variants' checks too.
     selected = f"{check}[{scene}-{variant_id(variant)}]" if variant else f"{check}[{scene}]"
+    given = []
+    if pictures is not None and pictures.golden_dir is not None:
+        given += ["--conformance-golden-dir", os.path.relpath(pictures.golden_dir)]
+    if pictures is not None and pictures.override:
+        given += ["--conformance-image-tolerance", pictures.override]
     return shlex.join(["pytest", "--pyargs", "conformance", "-k", selected, "--sync", sync,
-                       *(["--conformance-scenes", *source] if source else [])])
+                       *(["--scenes", *source] if source else []), *given])
 
 
 def _goldens(pictures, scene, params=None):
@@ -92,7 +101,7 @@ def test_golden_render(scene_name, variant, kit, pictures, request):
                       f" [{scene_name}, frame {frame}]; the mistake, frame by frame: "
                       f"{reproduce_command(scene_name, kit.sync, max(frame, 1), variant)}"]
         record.details["physics"] = physics[frame].as_dict()
-        record.reproduce = _reproduce("test_golden_render", scene_name, kit.sync, variant)
+        record.reproduce = _reproduce("test_golden_render", scene_name, kit.sync, variant, pictures)
         record.nodeid = request.node.nodeid
         pictures.keep(record, images)
         request.node.user_properties.append((reftest.GOLDEN_VERDICTS, {"frame": frame, **record.details["verdicts"]}))

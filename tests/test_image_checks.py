@@ -157,3 +157,20 @@ def test_image_checks_alone_fail_a_wrong_sync_end_to_end(tmp_path):
     assert any(name.endswith("-difference.png") for name in pictures), pictures
     page = (results / "report.html").read_text(encoding="utf-8")
     assert "brick_wall_single" in page and "data:image/png;base64," in page
+
+
+def test_a_golden_failure_s_reproduce_line_keeps_the_golden_dir_and_tolerance_given(tmp_path, monkeypatch):
+    """Issue 30: a printed command runs as printed, with the options the user gave; the golden check's
+    reproduce line dropped --conformance-golden-dir, so it replayed against the kit's goldens."""
+    from types import SimpleNamespace
+
+    from conformance import test_golden
+
+    monkeypatch.chdir(tmp_path)
+    pictures = SimpleNamespace(golden_dir=tmp_path / "mine", override="other-renderer")
+    words = shlex.split(test_golden._reproduce("test_golden_render", "free_fall", "reference", None, pictures))
+    assert words[words.index("--conformance-golden-dir") + 1] == "mine"
+    assert words[words.index("--conformance-image-tolerance") + 1] == "other-renderer"
+    plain = shlex.split(test_golden._reproduce("test_golden_render", "free_fall", "reference", None,
+                                               SimpleNamespace(golden_dir=None, override=None)))
+    assert "--conformance-golden-dir" not in plain and "--conformance-image-tolerance" not in plain
