@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import subprocess
 import sys
+import shlex
 import textwrap
 from pathlib import Path
 
@@ -201,3 +202,13 @@ def test_every_buffer_and_range_an_app_changes_is_announced(tmp_path, change, ne
         assert verdict.passed, verdict.message()
     else:
         assert not verdict.passed and re.search(needle, verdict.message()), verdict.message()
+
+
+def test_an_app_s_reproduce_line_keeps_its_tick_function():
+    """A printed command runs as printed: an app whose loop is its own needs its --tick again."""
+    from conformance.apps import reproduce_command
+
+    words = shlex.split(reproduce_command("my app.py", 30, [{"kind": "kick"}], "on_frame"))
+    assert words[:4] == ["python", "-m", "conformance", "app"] and words[4] == "my app.py"
+    assert words[words.index("--tick") + 1] == "on_frame" and words[words.index("--ticks") + 1] == "30"
+    assert "--tick" not in shlex.split(reproduce_command("app.py", 30))

@@ -39,17 +39,22 @@ class AppResult:
     events: list
     recording: Recording
     verdicts: dict = field(default_factory=dict)
+    tick_function: str | None = None
 
     @property
     def passed(self) -> bool:
         return all(v.passed for v in self.verdicts.values())
 
     def reproduce(self) -> str:
-        return reproduce_command(self.script, self.ticks, self.events)
+        return reproduce_command(self.script, self.ticks, self.events, self.tick_function)
 
 
-def reproduce_command(script: str, ticks: int, events=()) -> str:
+def reproduce_command(script: str, ticks: int, events=(), tick_function: str | None = None) -> str:
+    """The command that runs this run of the app again, with the --tick it was given (without it, an
+    app whose loop is its own cannot be run)."""
     command = f"python -m conformance app {shlex.quote(str(script))} --ticks {ticks}"
+    if tick_function:
+        command += f" --tick {shlex.quote(tick_function)}"
     if events:
         command += f" --events {shlex.quote(json.dumps(list(events), separators=(',', ':')))}"
     return command
@@ -63,4 +68,5 @@ def check_app(script, *, ticks: int = DEFAULT_TICKS, events=(), tick_function=No
 
     kwargs = {} if timeout is None else {"timeout": timeout}
     recording = launch.record(script, ticks=ticks, events=events, tick_function=tick_function, **kwargs)
-    return AppResult(str(script), ticks, list(events), recording, judge(recording, tolerance=tolerance or DEFAULT))
+    return AppResult(str(script), ticks, list(events), recording, judge(recording, tolerance=tolerance or DEFAULT),
+                     tick_function)
