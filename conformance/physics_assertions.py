@@ -7,6 +7,8 @@ where: the scene with its parameters, the step, and the calls that set the premi
 
 from __future__ import annotations
 
+import math
+
 from typing import Any, Mapping
 
 import numpy as np
@@ -70,11 +72,17 @@ def assert_close(name: str, *, actual: float, expected: float, where: str, rtol:
                     pytrace=False)
 
 
-def assert_in_band(name: str, *, actual: float, low: float, high: float, where: str, law: str = "") -> None:
-    """low ≤ actual ≤ high."""
+def assert_in_band(name: str, *, actual: float, low: float, high: float, where: str, law: str = "",
+                   exact: float | None = None) -> None:
+    """low ≤ actual ≤ high. ``exact``: the law's own value inside the band (the rest is a measured
+    allowance), from which the figure is measured; without it, the band's middle."""
     __tracebackhide__ = True
-    # The use of a band is how far from its middle towards an edge: 1 on the edge.
-    figures.note(name, abs(actual - (low + high) / 2), (high - low) / 2, where=where)
+    # The use of a band is how far from the law's value (else its middle) towards the edge on that side:
+    # 1 on the edge. From the middle, a ball that does not bounce at all (apex/drop 0, the law's value
+    # and the band's low edge) used 100 % of [0, 1e-3].
+    centre = (low + high) / 2 if exact is None else exact
+    edge = high if actual >= centre else low
+    figures.note(name, abs(actual - centre), abs(edge - centre) or math.ulp(1.0), where=where)
     if not (low <= actual <= high):
         pytest.fail(f"{name}={actual:.6g}, but should be in [{low:.6g}, {high:.6g}]"
                     + (f" ({law})" if law else "") + f" {where}", pytrace=False)

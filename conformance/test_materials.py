@@ -49,7 +49,9 @@ EXACT = dict(rtol=1e-12, atol=1e-12)
 DEFAULT_DAMPING = dict(rtol=1e-7, atol=1e-12)
 #: First-rebound apex over drop height lies in [e², e² + BOUNCE_EXCESS] (measured e² + 0.003..0.021).
 BOUNCE_EXCESS = 0.05
-#: Mean sliding deceleration over μ_a·μ_b·g (measured within ±0.9 % over 300 draws).
+#: Mean sliding deceleration over μ_a·μ_b·g: measured within 1.39 % over 3,000 random draws of the scene's
+#: parameters (2026-11-26), the worst at the space's corner (a 5 cm box, both frictions and the speed 1:
+#: 18 frames to average); the precision tables' worst over 9,000 more, 92 % of this.
 FRICTION_RTOL = 0.015
 
 
@@ -213,10 +215,10 @@ def verify_bounce(steps: int, ball_restitution: float, ground_restitution: float
         ratio, impact = bounce_ratio(scene, scene.bindings[1].body, radius, drop, 4 * steps + 40)
     where = context("bouncing_ball", params, f"impact at step {impact}")
     if e == 0.0:
-        assert_in_band("apex/drop", actual=ratio, low=0.0, high=1e-3, where=where,
+        assert_in_band("apex/drop", actual=ratio, low=0.0, high=1e-3, where=where, exact=0.0,
                        law="no bounce: the combined restitution e_ball·e_ground is 0")
     else:
-        assert_in_band("apex/drop", actual=ratio, low=e * e, high=e * e + BOUNCE_EXCESS, where=where,
+        assert_in_band("apex/drop", actual=ratio, low=e * e, high=e * e + BOUNCE_EXCESS, where=where, exact=e * e,
                        law=f"e² .. e² + {BOUNCE_EXCESS} with e = {e:.6g}")
 
 

@@ -122,3 +122,24 @@ def test_a_journal_keeps_each_draw_and_a_run_goes_on_where_it_stopped(tmp_path, 
     assert sorted(made) == ["--hypothesis-seed=2", "--hypothesis-seed=3"]
     assert [d.seed for d in draws] == [1, 2, 3] and draws[0].records[0]["figures"]["vertex position"]["use"] == 0.2
     assert {k[2] for k in precision.Journal(path).made} == {1, 2, 3}
+
+
+def test_a_band_s_figure_is_measured_from_the_law_s_value():
+    """A ball that does not bounce at all (apex/drop 0, the law's value and the band's low edge) used
+    100 % of [0, 1e-3] measured from the band's middle; from the law's value it uses none, and the
+    band's far edge is still 100 %. Outside the band the assertion fails as before."""
+    import pytest as _pytest
+
+    from conformance.physics_assertions import assert_in_band
+
+    def use(actual, **band):
+        with figures.tally() as noted:
+            assert_in_band("apex/drop", actual=actual, where="[here]", **band)
+        return noted["apex/drop"]["use"]
+
+    assert use(0.0, low=0.0, high=1e-3, exact=0.0) == 0.0
+    assert use(1e-3, low=0.0, high=1e-3, exact=0.0) == _pytest.approx(1.0)
+    assert use(0.25 + 0.025, low=0.25, high=0.30, exact=0.25) == _pytest.approx(0.5)
+    assert use(0.0, low=0.0, high=1e-3) == _pytest.approx(1.0)  # no law's value given: from the middle
+    with _pytest.raises(_pytest.fail.Exception, match=r"apex/drop=0.002, but should be in \[0, 0.001\]"):
+        assert_in_band("apex/drop", actual=2e-3, low=0.0, high=1e-3, where="[here]", exact=0.0)
