@@ -44,8 +44,19 @@ class InterruptedOnFreeFall(MisbehavesOnFreeFall):
 
 
 class CtrlCOnFreeFall(MisbehavesOnFreeFall):
-    """Presses Ctrl-C at that call: SIGINT to its whole process group, as a terminal sends it to the
-    command in the foreground and everything it started (``tests/test_kit_interrupt.py``)."""
+    """Presses Ctrl-C at the 50th call on ``free_fall`` counted over every instance of the process (a
+    profile's checks may each make fewer calls than that): SIGINT to its whole process group, as a
+    terminal sends it to the command in the foreground and everything it started
+    (``tests/test_kit_interrupt.py``)."""
+
+    calls_in_this_process = 0
+
+    def __call__(self):
+        if self.scene == SCENE:
+            type(self).calls_in_this_process += 1
+            if type(self).calls_in_this_process == CALL:
+                self.misbehave()
+        return ReferenceSync.__call__(self)
 
     def misbehave(self):
         import os
