@@ -18,10 +18,10 @@ import shlex
 from dataclasses import dataclass, field
 
 from conformance.apps.judge import CHECKS, DIAGNOSES, Verdict, judge
-from conformance.apps.launch import AppFailed, record
+from conformance.apps.launch import AppFailed, KitFailed, record
 from conformance.apps.recording import Recording
 
-__all__ = ["CHECKS", "DIAGNOSES", "AppFailed", "AppResult", "Recording", "Verdict", "check_app", "judge", "record",
+__all__ = ["CHECKS", "DIAGNOSES", "AppFailed", "AppResult", "KitFailed", "Recording", "Verdict", "check_app", "judge", "record",
            "reproduce_command"]
 
 #: ticks of an app's own run, unless told otherwise

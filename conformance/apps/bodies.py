@@ -51,6 +51,10 @@ class Frame:
     #: link frame, and ``points`` the shape's extreme points in its own frame, scaled (a mesh's convex hull,
     #: a box's corners, a cylinder's rims): what a drawing of it spans. pyBullet's own renderer draws these.
     visuals: tuple = ()
+    #: a soft body's simulated node (its index in ``getMeshData(body, -1, flags=MESH_DATA_SIMULATION_MESH)``),
+    #: else -1. A node is a frame with a position and no turn: what follows it moves with it; it has no
+    #: collision shape, and pyBullet reports no mass for it (``mass`` is NaN).
+    node: int = -1
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -58,7 +62,7 @@ class Frame:
     @property
     def label(self) -> str:
         """``body 3 link 1 (name)``; on a client other than 0, ``client 1 body 3 …`` (body ids restart on every client)."""
-        where = "base" if self.link == -1 else f"link {self.link}"
+        where = f"node {self.node}" if self.node >= 0 else "base" if self.link == -1 else f"link {self.link}"
         client = f"client {self.client} " if self.client else ""
         return f"{client}body {self.body} {where}" + (f" ({self.name})" if self.name else "")
 
@@ -151,8 +155,24 @@ def _shapes(p: BoundClient, body: int, link: int) -> tuple:
     return tuple(found)
 
 
+def _nodes(p: BoundClient, body: int) -> int:
+    """How many simulated nodes ``body`` has if it is a soft body (``loadSoftBody``, ``loadURDF`` of a
+    deformable), else 0. pyBullet has no call that says so: a soft body is one whose collision shapes it
+    cannot report (``getCollisionShapeData`` raises) and whose simulation mesh it can."""
+    try:
+        p.getCollisionShapeData(body, -1)
+        return 0
+    except pybullet.error:
+        pass
+    try:
+        return int(p.getMeshData(body, -1, flags=pybullet.MESH_DATA_SIMULATION_MESH)[0])
+    except pybullet.error:
+        return 0
+
+
 def frames_of(clients) -> list[Frame]:
-    """Every base and link of every body on ``clients`` (ids), in client, body and link order."""
+    """Every base and link of every rigid body and every node of every soft body on ``clients`` (ids), in
+    client, body and link (node) order."""
     frames = []
     for client in clients:
         p = BoundClient(client)
@@ -160,6 +180,10 @@ def frames_of(clients) -> list[Frame]:
             body = p.getBodyUniqueId(index)
             base_name, body_name = (_text(v) for v in p.getBodyInfo(body))
             name = body_name if body_name and body_name != base_name else base_name
+            nodes = _nodes(p, body)
+            if nodes:
+                frames.extend(Frame(client, body, -1, name, float("nan"), (), node=n) for n in range(nodes))
+                continue
             visuals = _visuals(p, body)
             for link in range(-1, p.getNumJoints(body)):
                 info = p.getDynamicsInfo(body, link)
@@ -175,19 +199,30 @@ def read_poses(frames: list[Frame]) -> tuple[np.ndarray, np.ndarray]:
     positions = np.empty((len(frames), 3))
     orientations = np.empty((len(frames), 4))
     by_client: dict[int, list[int]] = {}
+    soft: dict[tuple[int, int], list[int]] = {}
     for i, frame in enumerate(frames):
-        by_client.setdefault(frame.client, []).append(i)
+        if frame.node >= 0:
+            soft.setdefault((frame.client, frame.body), []).append(i)
+        else:
+            by_client.setdefault(frame.client, []).append(i)
     for client, rows in by_client.items():
         pos, orn = truth.link_frames(BoundClient(client), [(frames[i].body, frames[i].link) for i in rows])
         positions[rows], orientations[rows] = pos, orn
+    for (client, body), rows in soft.items():
+        nodes = np.asarray(pybullet.getMeshData(body, -1, flags=pybullet.MESH_DATA_SIMULATION_MESH,
+                                                physicsClientId=client)[1], dtype=np.float64)
+        positions[rows] = nodes[[frames[i].node for i in rows]]
+        orientations[rows] = (0.0, 0.0, 0.0, 1.0)
     return positions, orientations
 
 
 def read_velocities(frames: list[Frame]) -> np.ndarray:
     """Linear and angular velocities ``(F, 6)`` of ``frames``' centres of mass, now (read only when the kit
     has to tell whether the app changed them: it costs one call per frame)."""
-    velocities = np.empty((len(frames), 6))
+    velocities = np.zeros((len(frames), 6))
     for i, frame in enumerate(frames):
+        if frame.node >= 0:
+            continue  # pyBullet reports no node's velocity: the kit cannot tell whether the app set one
         if frame.link == -1:
             linear, angular = pybullet.getBaseVelocity(frame.body, physicsClientId=frame.client)
         else:

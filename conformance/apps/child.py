@@ -4,7 +4,8 @@ Runs the app's script unmodified as ``__main__`` (with ``sys.argv = [SCRIPT]`` a
 ``sys.path``, as ``python SCRIPT`` would), with the kit's patches (:mod:`conformance.apps.driver`) in
 place, and writes what it recorded to ``--out``. Exit status: 0 recorded (the app may still have
 raised inside its loop: the recording says so), 3 the app failed before its loop or handed over no
-loop, or (FURY 0.12) the OpenGL driver cannot start (``--out`` + ``.error`` holds the paragraph). Run by :mod:`conformance.apps.launch`, in a process of
+loop, or (FURY 0.12) the OpenGL driver cannot start (``--out`` + ``.error`` holds the paragraph), 4 the
+kit's own code failed while it drove the app (``--out`` + ``.kit-error`` holds what and where). Run by :mod:`conformance.apps.launch`, in a process of
 its own so that an app's globals, patches, crashes and hangs never reach the kit's.
 """
 
@@ -26,6 +27,13 @@ def _fail(out: str, text: str) -> int:
 
     write_atomically(out + ".error", text.encode("utf-8"))
     return 3
+
+
+def _kit_failed(out: str, fault) -> int:
+    from conformance.files import write_atomically
+
+    write_atomically(out + ".kit-error", fault.text.encode("utf-8"))
+    return 4
 
 
 def main(argv=None) -> int:
@@ -66,6 +74,8 @@ def main(argv=None) -> int:
     sys.path.insert(0, str(Path(script).parent))
     try:
         runpy.run_path(script, run_name="__main__")
+    except app_driver.KitFault as fault:
+        return _kit_failed(args.out, fault)
     except SystemExit as exc:
         if exc.code not in (None, 0) and driver.recording is None:
             return _fail(args.out, f"{args.script}: the app exited with status {exc.code} before its loop ran.")
@@ -82,6 +92,8 @@ def main(argv=None) -> int:
             driver.reached("")  # the script ended with callbacks registered and nothing to run them
         except app_driver.AppLoopNotFound as err:
             return _fail(args.out, str(err))
+        except app_driver.KitFault as fault:
+            return _kit_failed(args.out, fault)
     if driver.error:
         driver.recording.error = driver.error
     recording.save(driver.recording, args.out)

@@ -37,7 +37,7 @@ from conformance.apps import bodies, mapping
 from conformance.apps.recording import ActorTrack, Recording
 from conformance.errors import ConformanceError
 
-__all__ = ["AppLoopNotFound", "Driver"]
+__all__ = ["AppLoopNotFound", "Driver", "KitFault"]
 
 
 #: pyBullet's calls that change a body's pose or velocity (pybullet Quickstart, "Base, Joints, Links")
@@ -47,6 +47,33 @@ STATE_WRITERS = ("resetBasePositionAndOrientation", "resetBaseVelocity", "resetJ
 
 class AppLoopNotFound(ConformanceError):
     """The app never handed the kit a per-frame function it could drive."""
+
+
+class KitFault(BaseException):
+    """The kit's own code failed while it drove the app: a fault of the kit, never the app's. A
+    ``BaseException``, so that an app that wraps its callback in ``except Exception`` cannot swallow it, and
+    the driver's own "the app raised" handling never takes it for the app's."""
+
+    def __init__(self, where: str, exc: BaseException):
+        self.text = (f"{where}: {type(exc).__name__}: {exc}\n"
+                     + "".join(traceback.format_exception(exc)).rstrip())
+        super().__init__(self.text)
+
+
+def _kit_code(where: str):
+    """Run the decorated driver method as the kit's code: what it raises, other than the kit's messages to
+    the user (:class:`~conformance.errors.ConformanceError`), is a :class:`KitFault`."""
+    def decorate(method):
+        @functools.wraps(method)
+        def guarded(*args, **kwargs):
+            try:
+                return method(*args, **kwargs)
+            except (KitFault, ConformanceError):
+                raise
+            except Exception as exc:
+                raise KitFault(where, exc) from exc
+        return guarded
+    return decorate
 
 
 HOW_TO_EXPOSE = (
@@ -161,6 +188,7 @@ class Driver:
         self._writers: set[str] = set()
         self._kit_writing = False  # the kit's own after-step events are not the app's writes
         self._after_step_due: set[int] = set()  # the clients whose first step of this tick is still to come
+        self.fault: KitFault | None = None  # a fault of the kit's that a window loop swallowed
 
     # -- what the patches call ------------------------------------------------------------------
     def offer(self, source) -> None:
@@ -187,6 +215,13 @@ class Driver:
             self.error = (f"the app raised at tick {self._tick}: {type(exc).__name__}: {exc}\n"
                           + "".join(traceback.format_exception(exc)[-6:]))
 
+    @_kit_code("recording the state before the app's write")
+    def faulted(self, fault: BaseException) -> None:
+        """A :class:`KitFault` went through a window loop that swallows what its callbacks raise (VTK's
+        observers): keep the first, for the loop to raise once the tick is over."""
+        if isinstance(fault, KitFault) and self.fault is None:
+            self.fault = fault
+
     def before_write(self, name: str) -> None:
         """The app is about to write to pyBullet's state: after this tick's last step that is the sync's part
         of the tick, which should only read. The state before the first such write is kept to compare."""
@@ -198,6 +233,7 @@ class Driver:
                 self._reading += time.perf_counter() - start
             self._writers.add(name)
 
+    @_kit_code("reading every frame before a step")
     def before_step(self) -> None:
         self._stepped, self._written = True, None
         self._writers = set()
@@ -207,6 +243,7 @@ class Driver:
             self._steps += 1
             self._reading += time.perf_counter() - start
 
+    @_kit_code("applying the kit's after-step events")
     def after_step(self, client: int) -> None:
         """``client``'s first step of the tick is done: apply the tick's
         :class:`~conformance.apps.perturb.AfterStep` events to its bodies."""
@@ -230,6 +267,7 @@ class Driver:
                 return source
         return None
 
+    @_kit_code("driving the app's loop")
     def run(self) -> None:
         """Drive the app's loop for up to ``ticks`` ticks, recording after each; keeps what it saw even
         when the app raises (``self.error``)."""
@@ -280,30 +318,35 @@ class Driver:
 
         pictures = []
         early = set(picture_ticks(self.ticks)) - {self.ticks}  # the last is taken where the run ends
-        try:
-            for tick in range(1, self.ticks + 1):
-                self._tick = tick
-                self._stepped, self._written, self._writers = False, None, set()  # the kit's own events are not the app's
-                perturb.apply(self.events, tick, self._frames)
-                if any(isinstance(e, perturb.AfterStep) and e.frame == tick for e in self.events):
-                    self._after_step_due = {f.client for f in self._frames}
-                self._steps = 0
-                self._before = None
-                start = time.perf_counter()
+        for tick in range(1, self.ticks + 1):
+            self._tick = tick
+            self._stepped, self._written, self._writers = False, None, set()  # the kit's own events are not the app's
+            perturb.apply(self.events, tick, self._frames)
+            if any(isinstance(e, perturb.AfterStep) and e.frame == tick for e in self.events):
+                self._after_step_due = {f.client for f in self._frames}
+            self._steps = 0
+            self._before = None
+            start = time.perf_counter()
+            try:
                 source.tick()
-                self._after_step_due = set()  # a client that did not step this tick gets none
-                middle = time.perf_counter()
-                snapshot()
-                in_ticks, in_snapshots = in_ticks + middle - start, in_snapshots + time.perf_counter() - middle
-                steps.append(self._steps)
-                if tick in early:
-                    pictures.append(self._picture(source, tracks, clients, tick))
-                if source.done():
-                    ended = f"{source.ended()} after tick {tick}"
-                    break
-        except Exception as exc:  # the app's own code raised inside its callback: that is a verdict
-            self.raised(exc)
-            ended = f"the app raised at tick {len(steps)}"
+                if self.fault is not None:
+                    raise self.fault
+            except (KitFault, ConformanceError):
+                raise
+            except Exception as exc:  # the app's own code raised inside its callback: that is a verdict
+                self.raised(exc)
+                ended = f"the app raised at tick {len(steps)}"
+                break
+            self._after_step_due = set()  # a client that did not step this tick gets none
+            middle = time.perf_counter()
+            snapshot()
+            in_ticks, in_snapshots = in_ticks + middle - start, in_snapshots + time.perf_counter() - middle
+            steps.append(self._steps)
+            if tick in early:
+                pictures.append(self._picture(source, tracks, clients, tick))
+            if source.done():
+                ended = f"{source.ended()} after tick {tick}"
+                break
         if not pictures or pictures[-1]["tick"] != len(steps) - 1:
             pictures.append(self._picture(source, tracks, clients, len(steps) - 1))
         notes = list(self.notes)

@@ -88,6 +88,12 @@ class Verdict:
     def message(self) -> str:
         return "\n".join(self.lines)
 
+    def diagnosed(self, diagnosis: str) -> None:
+        """Name the mistake (a key of :data:`DIAGNOSES`) under the last line, if there is one."""
+        if diagnosis:
+            self.lines.append(f"    diagnosis: {DIAGNOSES[diagnosis]}")
+            self.diagnoses.append(diagnosis)
+
 
 def _rotations(q: np.ndarray) -> np.ndarray:
     return Rotation.from_quat(q.reshape(-1, 4)).as_matrix().reshape(q.shape[:-1] + (3, 3))
@@ -121,6 +127,8 @@ class _Judgement:
     def _outside(self, frame: int, points: np.ndarray) -> np.ndarray:
         """How far link-frame ``points`` lie outside ``frame``'s collision and visual shapes (0 on or inside one)."""
         info = self.r.frames[frame]
+        if info.node >= 0:  # a soft body's node is a point: a vertex drawn on it lies at its origin
+            return np.linalg.norm(np.asarray(points, dtype=np.float64), axis=-1)
         return distance_to_shapes(points, info.shapes, info.mesh, info.visuals)
 
     def _apply_mapping(self, entry: dict) -> None:
@@ -169,6 +177,7 @@ class _Judgement:
             if tied:
                 verdict.notes.append(f"{track.label}: {tied} vertices are held equally by two frames that never moved "
                                      "apart in this run (undecidable; the kit's perturbed runs move bodies apart)")
+            soft: dict[tuple, list] = {}  # pieces that follow nodes of one soft body: one line for them all
             for start, stop, frame, diagnosis in self._loose_pieces(track, a, loose):
                 verdict.passed = False
                 rows = np.arange(start, stop)
@@ -177,14 +186,27 @@ class _Judgement:
                 first = int(bad_ticks[0]) if len(bad_ticks) else 0
                 k = int(np.argmax(error.max(axis=0)))
                 self.followed_badly.add(frame)
+                info = self.r.frames[frame] if frame >= 0 else None
+                if info is not None and info.node >= 0:
+                    soft.setdefault((info.client, info.body, info.name, diagnosis), []).append(
+                        (rows, error[:, first].max(), first, error[:, k].max(), k, allowance.max()))
+                    continue
                 verdict.lines.append(
                     f"{track.label} ({track.kind}) vertices {start}:{stop} of {len(a.frame)}: not held by any frame; "
                     f"follows {self.frame_label(frame)} best, and left it at tick {first + 1}: "
                     f"{error[:, first].max():.3g} m from where that frame carries it (allowed "
                     f"{allowance.max():.3g} m); worst {error[:, k].max():.3g} m at tick {k + 1}")
-                if diagnosis:
-                    verdict.lines.append(f"    diagnosis: {DIAGNOSES[diagnosis]}")
-                    verdict.diagnoses.append(diagnosis)
+                verdict.diagnosed(diagnosis)
+            for (client, body, name, diagnosis), pieces in soft.items():
+                rows = np.concatenate([piece[0] for piece in pieces])
+                first = min(pieces, key=lambda piece: piece[2])
+                farthest = max(pieces, key=lambda piece: piece[3])
+                verdict.lines.append(
+                    f"{track.label} ({track.kind}) vertices {_ranges(rows)} of {len(a.frame)}: not held by any frame; "
+                    f"each follows a node of {'client %d ' % client if client else ''}soft body {body} ({name}) best, "
+                    f"and the first left it at tick {first[2] + 1}: {first[1]:.3g} m from that node (allowed "
+                    f"{max(piece[5] for piece in pieces):.3g} m); worst {farthest[3]:.3g} m at tick {farthest[4] + 1}")
+                verdict.diagnosed(diagnosis)
         for entry in self.r.mapping:
             self._judge_mapped(entry, verdict)
         welded = sum(int(a.welded.sum()) for a in self.attachments if a.welded is not None)
@@ -192,7 +214,9 @@ class _Judgement:
             groups = {}
             for i, g in enumerate(self.welds):
                 if g >= 0:
-                    groups.setdefault(int(g), []).append(self.r.frames[i].name or self.frame_label(i))
+                    frame = self.r.frames[i]
+                    name = f"{frame.name} node {frame.node}" if frame.node >= 0 else frame.name
+                    groups.setdefault(int(g), []).append(name or self.frame_label(i))
             together = "; ".join(" + ".join(names) for names in groups.values())
             verdict.notes.append(f"{welded} vertices are held by frames welded together (fixed joints, or links that never "
                                  f"moved apart: {together}): each went to the frame whose shape it lies on")
@@ -222,9 +246,7 @@ class _Judgement:
                 line += f"; they are held by {self.frame_label(other)} instead"
                 diagnosis = "other-body"
         verdict.lines.append(line)
-        if diagnosis:
-            verdict.lines.append(f"    diagnosis: {DIAGNOSES[diagnosis]}")
-            verdict.diagnoses.append(diagnosis)
+        verdict.diagnosed(diagnosis)
 
     def _loose_pieces(self, track, a, loose):
         """``(start, stop, frame, diagnosis)`` of the actor's loose vertices, one per body or link they were
@@ -344,6 +366,7 @@ class _Judgement:
         followed = set(self.followed_badly)  # loose vertices that follow a frame are the attached check's
         for a in self.attachments:
             followed.update(int(f) for f in np.unique(a.frame[a.held]) if f >= 0)
+        self._soft_drawn(verdict, followed)
         for index, frame in enumerate(self.r.frames):
             if index in followed or not frame.shapes:
                 continue
@@ -357,9 +380,35 @@ class _Judgement:
             near = self._left_behind(index)
             verdict.lines.append(line + (f"; {near} stays where it was built" if near else ""))
             if near:
-                verdict.lines.append(f"    diagnosis: {DIAGNOSES['never-moved']}")
-                verdict.diagnoses.append("never-moved")
+                verdict.diagnosed("never-moved")
         return verdict
+
+    def _soft_drawn(self, verdict: Verdict, followed: set) -> None:
+        """A soft body is drawn when every node of it that moves is followed by some drawn vertex: a program
+        that copies all but the last node, or none, leaves nodes moving with nothing drawn on them."""
+        for (client, body), nodes in self._soft_bodies().items():
+            allowance = 10 * self.tolerance.for_extents(np.zeros(len(nodes)), self.pos[0, nodes])
+            moved = np.array([self._movement(i, 0.0) for i in nodes])
+            missing = [i for i, m, a in zip(nodes, moved, allowance) if m > a and i not in followed]
+            if not missing:
+                continue
+            verdict.passed = False
+            frame = self.r.frames[nodes[0]]
+            numbers = [self.r.frames[i].node for i in missing]
+            shown = ", ".join(map(str, numbers[:8])) + (f" … ({len(numbers)} of {len(nodes)})" if len(numbers) > 8 else "")
+            verdict.lines.append(f"{'client %d ' % client if client else ''}soft body {body} ({frame.name}): "
+                                 f"node{'s' if len(numbers) > 1 else ''} {shown} move (up to "
+                                 f"{max(moved[nodes.index(i)] for i in missing):.3g} m over ticks 1..{self.r.ticks}) but no "
+                                 "drawn vertex follows them: copy every node of getMeshData(body, -1, "
+                                 "flags=p.MESH_DATA_SIMULATION_MESH) into the actor after each step")
+
+    def _soft_bodies(self) -> dict[tuple[int, int], list[int]]:
+        """The node frames of each soft body, by (client, body)."""
+        found: dict[tuple[int, int], list[int]] = {}
+        for index, frame in enumerate(self.r.frames):
+            if frame.node >= 0:
+                found.setdefault((frame.client, frame.body), []).append(index)
+        return found
 
     def _movement(self, index: int, radius: float) -> float:
         if self.r.ticks == 0:
@@ -419,8 +468,12 @@ class _Judgement:
 
     def placed(self) -> Verdict:
         verdict = Verdict("placed", True)
+        soft: dict[tuple, list] = {}
         for track, a, frame, rows, result in self.placements():
             info = self.r.frames[frame]
+            if info.node >= 0:  # a node has no shape to be drawn on: what follows it is held to it by `attached`
+                soft.setdefault((track.label, info.client, info.body, info.name), []).append(rows)
+                continue
             where = f"{track.label} vertices {_ranges(rows)} held by {info.label}"
             if not result.judged:
                 verdict.notes.append(f"{where}: {result.why}")
@@ -428,9 +481,11 @@ class _Judgement:
                 verdict.passed = False
                 diagnosis = result.diagnosis or self._other_body(result.offset, frame)
                 verdict.lines.append(f"{where}: {result.why}")
-                if diagnosis:
-                    verdict.lines.append(f"    diagnosis: {DIAGNOSES[diagnosis]}")
-                    verdict.diagnoses.append(diagnosis)
+                verdict.diagnosed(diagnosis)
+        for (label, client, body, name), rows in soft.items():
+            verdict.notes.append(f"{label} vertices {_ranges(np.sort(np.concatenate(rows)))} follow nodes of "
+                                 f"{'client %d ' % client if client else ''}soft body {body} ({name}): held to "
+                                 "those nodes by `attached`; a node has no shape to judge a placement against")
         return verdict
 
     def _inertial(self, frame: int) -> np.ndarray:
@@ -464,8 +519,7 @@ class _Judgement:
                 verdict.lines.append(f"{track.label} normals {start}:{stop}: do not turn with {self.frame_label(int(frames[start]))} "
                                      f"from tick {first + 1} ({np.degrees(angle[:, start:stop].max()):.3g}° off; allowed "
                                      f"{np.degrees(self.tolerance.normal_angle):.3g}°)")
-                verdict.lines.append(f"    diagnosis: {DIAGNOSES['stale-normals']}")
-                verdict.diagnoses.append("stale-normals")
+                verdict.diagnosed("stale-normals")
         verdict.worst = worst
         return verdict
 
@@ -481,8 +535,7 @@ class _Judgement:
                 what = (f"at tick {silent[0]} {words}" if words else
                         f"its vertex data changed at tick {silent[0]} without being announced to the renderer")
                 verdict.lines.append(f"{track.label} ({track.kind}): {what} ({len(silent)} ticks in all)")
-                verdict.lines.append(f"    diagnosis: {DIAGNOSES['unannounced']}")
-                verdict.diagnoses.append("unannounced")
+                verdict.diagnosed("unannounced")
         return verdict
 
 
@@ -519,8 +572,7 @@ class _Judgement:
         pose_writers = {"resetBasePositionAndOrientation", "resetJointState", "resetJointStateMultiDof",
                         "resetJointStatesMultiDof"}
         if pose_writers & set(calls.split(", ")) and np.all(near[changed]):
-            verdict.lines.append(f"    diagnosis: {DIAGNOSES['written-back']}")
-            verdict.diagnoses.append("written-back")
+            verdict.diagnosed("written-back")
         verdict.worst = float(change.max())
         return verdict
 

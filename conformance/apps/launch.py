@@ -18,7 +18,7 @@ from pathlib import Path
 from conformance.apps import recording as recording_mod
 from conformance.errors import ConformanceError
 
-__all__ = ["AppFailed", "record"]
+__all__ = ["AppFailed", "KitFailed", "record"]
 
 #: seconds an app's whole run may take before the kit stops it
 DEFAULT_TIMEOUT = 300.0
@@ -26,6 +26,11 @@ DEFAULT_TIMEOUT = 300.0
 
 class AppFailed(ConformanceError):
     """The app could not be run to a recording; the message says why, in one paragraph."""
+
+
+class KitFailed(ConformanceError):
+    """The kit's own code failed while it ran the app: a fault of the kit, not a verdict on the app. The
+    message says so, with the kit's traceback, so that it can be reported and is never read as the app's."""
 
 
 def record(script: str | os.PathLike, *, ticks: int = 120, events=(), tick_function: str | None = None,
@@ -50,6 +55,11 @@ def record(script: str | os.PathLike, *, ticks: int = 120, events=(), tick_funct
             raise AppFailed(f"{script}: the app did not finish {ticks} ticks within {timeout:g} s and was stopped "
                             f"(a callback that never returns, or a loop of its own the kit did not take over). "
                             f"Its last output: {_tail(exc.stderr)}") from None
+        fault = Path(str(out) + ".kit-error")
+        if fault.exists():
+            raise KitFailed(f"{script}: the kit itself failed while it ran the app, a fault of the kit and not of "
+                            f"your program (nothing is judged; please report it with what follows): "
+                            f"{fault.read_text(encoding='utf-8').strip()}")
         error = Path(str(out) + ".error")
         if error.exists():
             raise AppFailed(error.read_text(encoding="utf-8").strip())

@@ -78,7 +78,7 @@ def resolve(script, app_module, actors, labels: dict[int, str], counts: list[int
         raise MappingError(f"{path}: the mapping raised {type(exc).__name__}: {exc}; fix it, or remove the file to "
                            "judge the app by attachment alone") from None
     by_actor = {id(a): i for i, a in enumerate(actors)}
-    by_frame = {(f.client, f.body, f.link): j for j, f in enumerate(frames)}
+    by_frame = {(f.client, f.body, f.link): j for j, f in enumerate(frames) if f.node < 0}
     with_bodies = [c for c in clients if any(f.client == c for f in frames)] or list(clients)
     resolved = []
     for n, entry in enumerate(entries):

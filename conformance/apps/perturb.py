@@ -43,7 +43,7 @@ def _scene(client: int, frames: list[Frame], dynamic: bool):
     from conformance.client import BoundClient
 
     p = BoundClient(client)
-    wanted = sorted({f.body for f in frames if f.client == client and f.link == -1 and (f.mass > 0 or not dynamic)})
+    wanted = sorted({f.body for f in frames if f.client == client and f.link == -1 and f.node < 0 and (f.mass > 0 or not dynamic)})
     dt = p.getPhysicsEngineParameters()["fixedTimeStep"]
     return SimpleNamespace(p=p, bindings=[SimpleNamespace(body=b) for b in wanted], dt=dt)
 

@@ -102,7 +102,7 @@ def touching(client: int, frames) -> list[list[int]]:
 
     from conformance.rendering.silhouettes import TOUCHING
 
-    index = {(f.body, f.link): i for i, f in enumerate(frames) if f.client == client}
+    index = {(f.body, f.link): i for i, f in enumerate(frames) if f.client == client and f.node < 0}
     pairs = set()
     for (body, link), i in index.items():
         low, high = pybullet.getAABB(body, link, physicsClientId=client)

@@ -97,6 +97,9 @@ def install(driver) -> None:
             except Exception as exc:
                 driver.raised(exc)
                 raise
+            except BaseException as fault:  # the kit's own (KitFault): VTK would swallow it like the app's
+                driver.faulted(fault)
+                raise
 
         return original_add(self, repeat, duration, observed)
 

@@ -1,6 +1,8 @@
 """``app PATH.py [PATH.py …] [--ticks N] [--perturbed K] [--seed S] [--events JSON] [--tick NAME] [--notes N|all]``: check your own
 program, unmodified: the kit runs it headless, drives its own per-frame callback, and judges what its
-actors draw against every body pyBullet simulates (no mapping needed; see conformance.apps)."""
+actors draw against every body pyBullet simulates (no mapping needed; see conformance.apps). Exit status 0
+every app passed, 1 some app failed, 3 the kit itself failed on some app (its traceback is printed; the app
+is not judged)."""
 
 from __future__ import annotations
 
@@ -80,7 +82,7 @@ def run(args, extra) -> int:
     from pathlib import Path
 
     results = Path(args.results or validation.DEFAULT_RESULTS)
-    failed = 0
+    failed = kit_failed = 0
     for path in args.paths:
         print(f"app {path} ({backends.describe()})")
         try:
@@ -89,11 +91,22 @@ def run(args, extra) -> int:
             print(f"  FAIL runs\n      {err}")
             failed += 1
             continue
+        except apps.KitFailed as err:
+            print(f"  ERROR kit\n      {err}")
+            print(f"verdict: NONE {path} (the kit failed, not the app)")
+            kit_failed += 1
+            continue
         print(f"  loop: {result.recording.loop}")
         _print_result(result, "own run" if not events else "run with the given events", results, notes)
         ok = result.passed
         if ok and events is None and runs:
-            found = perturbed.search(path, examples=runs, tick_function=args.tick, timeout=timeout, seed=seed)
+            try:
+                found = perturbed.search(path, examples=runs, tick_function=args.tick, timeout=timeout, seed=seed)
+            except apps.KitFailed as err:
+                print(f"  ERROR kit (a perturbed run)\n      {err}")
+                print(f"verdict: NONE {path} (the kit failed, not the app)")
+                kit_failed += 1
+                continue
             if found is None:
                 drawn = "" if seed is None else f", drawn from seed {seed}"
                 print(f"  PASS perturbed: {runs} runs of {apps.PERTURBED_TICKS} ticks with the kit's teleports, kicks and joint resets{drawn}")
@@ -102,4 +115,4 @@ def run(args, extra) -> int:
                 _print_result(found, f"perturbed run (events {json.dumps(found.events)}; not shrunk)", results, notes)
         failed += not ok
         print(f"verdict: {'PASS' if ok else 'FAIL'} {path}")
-    return 1 if failed else 0
+    return 3 if kit_failed else 1 if failed else 0

@@ -1,0 +1,76 @@
+"""Soft bodies in app mode (issue 32, points 1 and 2): a program that draws a cloth from pyBullet's
+simulated mesh runs under the kit (it used to stop on the kit's own ``getCollisionShapeData``), each
+drawn vertex that follows a node is held to that node at every tick, and every moving node must be
+followed. The right cloth app (``tests/apps/cloth_<backend>.py``) passes; copied with one mistake it
+fails the check that sees it, naming the soft body."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pybullet
+import pybullet_data
+
+from conformance import apps, backends
+from conformance.apps import bodies, perturbed
+
+CLOTH = Path(__file__).parent / "apps" / f"cloth_{backends.NAME}.py"
+SOURCE = CLOTH.read_text(encoding="utf-8")
+STEP = "    p.stepSimulation()\n    sync()\n"
+COPY = ("    cloth_vertices[:] = np.array(now)\n" if backends.NAME == "vtk"
+        else "    positions.data[:] = np.array(now, dtype=np.float32)\n")
+
+
+def _copy(tmp_path, text) -> Path:
+    path = tmp_path / "cloth.py"
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def test_a_soft_bodys_nodes_are_frames_with_a_position_and_no_turn():
+    client = pybullet.connect(pybullet.DIRECT)
+    try:
+        pybullet.resetSimulation(pybullet.RESET_USE_DEFORMABLE_WORLD, physicsClientId=client)
+        pybullet.setAdditionalSearchPath(pybullet_data.getDataPath(), physicsClientId=client)
+        cloth = pybullet.loadSoftBody("cloth_z_up.obj", basePosition=[0, 0, 1], scale=0.5, mass=1.0,
+                                      physicsClientId=client)
+        frames = bodies.frames_of([client])
+        nodes = pybullet.getMeshData(cloth, -1, flags=pybullet.MESH_DATA_SIMULATION_MESH, physicsClientId=client)[1]
+        assert [f.node for f in frames] == list(range(len(nodes))) and all(f.body == cloth for f in frames)
+        assert frames[3].label.startswith(f"body {cloth} node 3")
+        positions, orientations = bodies.read_poses(frames)
+        assert (positions == nodes).all() and (orientations == (0, 0, 0, 1)).all()
+    finally:
+        pybullet.disconnect(client)
+
+
+def test_the_right_cloth_app_passes_its_own_run_and_a_perturbed_one():
+    result = apps.check_app(CLOTH, ticks=60)
+    assert result.passed, {k: v.message() for k, v in result.verdicts.items() if not v.passed}
+    assert any("soft body 0 (cloth_z_up)" in note for note in result.verdicts["placed"].notes)
+    assert perturbed.search(CLOTH, examples=1) is None
+
+
+def test_a_cloth_copied_before_the_step_is_one_step_late(tmp_path):
+    late = SOURCE.replace(STEP, "    sync()\n    p.stepSimulation()\n")
+    assert late != SOURCE
+    verdict = apps.check_app(_copy(tmp_path, late), ticks=30).verdicts["attached"]
+    assert not verdict.passed and "previous-step" in verdict.diagnoses
+    assert "each follows a node of soft body 0 (cloth_z_up)" in verdict.message(), verdict.message()
+
+
+def test_a_cloth_never_copied_is_not_drawn(tmp_path):
+    never = SOURCE.replace(COPY, "    pass\n")
+    assert never != SOURCE
+    verdict = apps.check_app(_copy(tmp_path, never), ticks=60).verdicts["drawn"]
+    assert not verdict.passed
+    assert "soft body 0 (cloth_z_up): nodes 1, 2, 3" in verdict.message(), verdict.message()
+    assert "MESH_DATA_SIMULATION_MESH" in verdict.message()
+
+
+def test_a_cloth_copied_but_for_its_last_nodes_leaves_them_undrawn(tmp_path):
+    short = SOURCE.replace(COPY, COPY.replace("[:]", "[:-3]").replace("np.array(now", "np.array(now[:-3]"))
+    assert short != SOURCE
+    verdict = apps.check_app(_copy(tmp_path, short), ticks=60).verdicts
+    failed = {k for k, v in verdict.items() if not v.passed}
+    assert "drawn" in failed or "attached" in failed, failed
