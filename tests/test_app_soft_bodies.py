@@ -1,7 +1,7 @@
 """Soft bodies in app mode (issue 32, points 1 and 2): a program that draws a cloth from pyBullet's
 simulated mesh runs under the kit (it used to stop on the kit's own ``getCollisionShapeData``), each
 drawn vertex that follows a node is held to that node at every tick, and every moving node must be
-followed. The right cloth app (``tests/apps/cloth_<backend>.py``) passes; copied with one mistake it
+followed. The right cloth app (``examples/<backend>/cloth.py``) passes; copied with one mistake it
 fails the check that sees it, naming the soft body."""
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ import pybullet_data
 from conformance import apps, backends
 from conformance.apps import bodies, perturbed
 
-CLOTH = Path(__file__).parent / "apps" / f"cloth_{backends.NAME}.py"
+CLOTH = Path(__file__).resolve().parent.parent / "examples" / backends.NAME / "cloth.py"
 SOURCE = CLOTH.read_text(encoding="utf-8")
 STEP = "    p.stepSimulation()\n    sync()\n"
 COPY = ("    cloth_vertices[:] = np.array(now)\n" if backends.NAME == "vtk"
@@ -66,6 +66,20 @@ def test_a_cloth_never_copied_is_not_drawn(tmp_path):
     assert not verdict.passed
     assert "soft body 0 (cloth_z_up): nodes 1, 2, 3" in verdict.message(), verdict.message()
     assert "MESH_DATA_SIMULATION_MESH" in verdict.message()
+    assert "cloth_actor vertices" in verdict.message() and verdict.diagnoses == ["never-moved"], verdict.message()
+
+
+def test_a_cloth_drawn_off_its_nodes_is_not_placed(tmp_path):
+    """Each vertex that follows a node is drawn at it: one moved 5 cm off (a grid of the user's own,
+    a cloth built in another order than its nodes are copied) follows its node rigidly and is still wrong."""
+    if backends.NAME == "vtk":
+        off = SOURCE.replace(COPY, "    cloth_vertices[:] = np.array(now) + [0.05, 0, 0]\n")
+    else:
+        off = SOURCE.replace(COPY, "    positions.data[:] = np.array(now, dtype=np.float32) + np.float32([0.05, 0, 0])\n")
+    assert off != SOURCE
+    verdict = apps.check_app(_copy(tmp_path, off), ticks=30).verdicts["placed"]
+    assert not verdict.passed and verdict.diagnoses == ["node-order"], verdict.message()
+    assert "are not drawn at the node they follow" in verdict.message() and "0.05 m away" in verdict.message()
 
 
 def test_a_cloth_copied_but_for_its_last_nodes_leaves_them_undrawn(tmp_path):

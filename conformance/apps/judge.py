@@ -68,6 +68,10 @@ DIAGNOSES = {name: text for name, (text, _) in attach_mod.VARIANTS.items()} | {
                "it is drawn right, so the sync is not late but skips the body on some condition (zero velocity, "
                "a sleeping flag, a pose it takes as unchanged, every other call): draw every body whenever the "
                "sync is called (README, \"The sync protocol\")",
+    "node-order": "drawn at another node than the one it follows: the actor's vertices were built in another order "
+                  "than the nodes are copied into them (a mesh file read by another library reorders or merges "
+                  "vertices): build the actor from getMeshData(body, -1, flags=p.MESH_DATA_SIMULATION_MESH) and copy "
+                  "the nodes in that same order",
     "stale-gpu": "the GPU still holds older vertices of this body: the vertices were written but the range announced "
                  "with positions.update_range(offset, count) does not cover them (offset and count are in vertices); "
                  "announce every range written, or update_full()",
@@ -396,11 +400,33 @@ class _Judgement:
             frame = self.r.frames[nodes[0]]
             numbers = [self.r.frames[i].node for i in missing]
             shown = ", ".join(map(str, numbers[:8])) + (f" … ({len(numbers)} of {len(nodes)})" if len(numbers) > 8 else "")
+            left = self._left_at_nodes(missing)
             verdict.lines.append(f"{'client %d ' % client if client else ''}soft body {body} ({frame.name}): "
                                  f"node{'s' if len(numbers) > 1 else ''} {shown} move (up to "
                                  f"{max(moved[nodes.index(i)] for i in missing):.3g} m over ticks 1..{self.r.ticks}) but no "
                                  "drawn vertex follows them: copy every node of getMeshData(body, -1, "
-                                 "flags=p.MESH_DATA_SIMULATION_MESH) into the actor after each step")
+                                 "flags=p.MESH_DATA_SIMULATION_MESH) into the actor after each step"
+                                 + (f"; {left} stay where they were built, on those nodes" if left else ""))
+            if left:
+                verdict.diagnosed("never-moved")
+
+    def _left_at_nodes(self, nodes: list[int]) -> str:
+        """The actor ranges held by the world that were drawn, when the loop started, on ``nodes`` (frame
+        indices): a soft body drawn once and never copied again."""
+        from scipy.spatial import cKDTree
+
+        tree = cKDTree(self.r.positions[0, nodes])
+        found = []
+        for track, a in zip(self.r.actors, self.attachments):
+            world = np.flatnonzero((a.frame < 0) & a.held)
+            if not len(world):
+                continue
+            distance, _ = tree.query(track.vertices[0, world])
+            allowed = 10 * self.tolerance.for_extents(np.zeros(len(world)), track.vertices[0, world])
+            on = world[distance <= allowed]
+            if len(on):
+                found.append(f"{track.label} vertices {_ranges(on)}")
+        return ", ".join(found)
 
     def _soft_bodies(self) -> dict[tuple[int, int], list[int]]:
         """The node frames of each soft body, by (client, body)."""
@@ -471,8 +497,9 @@ class _Judgement:
         soft: dict[tuple, list] = {}
         for track, a, frame, rows, result in self.placements():
             info = self.r.frames[frame]
-            if info.node >= 0:  # a node has no shape to be drawn on: what follows it is held to it by `attached`
-                soft.setdefault((track.label, info.client, info.body, info.name), []).append(rows)
+            if info.node >= 0:
+                soft.setdefault((track.label, info.client, info.body, info.name), []).append(
+                    (rows, frame, self._off_node(a.reference[rows], frame)))
                 continue
             where = f"{track.label} vertices {_ranges(rows)} held by {info.label}"
             if not result.judged:
@@ -482,11 +509,31 @@ class _Judgement:
                 diagnosis = result.diagnosis or self._other_body(result.offset, frame)
                 verdict.lines.append(f"{where}: {result.why}")
                 verdict.diagnosed(diagnosis)
-        for (label, client, body, name), rows in soft.items():
-            verdict.notes.append(f"{label} vertices {_ranges(np.sort(np.concatenate(rows)))} follow nodes of "
-                                 f"{'client %d ' % client if client else ''}soft body {body} ({name}): held to "
-                                 "those nodes by `attached`; a node has no shape to judge a placement against")
+        for (label, client, body, name), pieces in soft.items():
+            rows = np.sort(np.concatenate([piece[0] for piece in pieces]))
+            soft_body = f"{'client %d ' % client if client else ''}soft body {body} ({name})"
+            off = [piece for piece in pieces if piece[2][0] > piece[2][1]]
+            if not off:
+                verdict.notes.append(f"{label} vertices {_ranges(rows)} follow nodes of {soft_body}, each drawn at its node")
+                continue
+            verdict.passed = False
+            worst = max(off, key=lambda piece: piece[2][0] / max(piece[2][1], 1e-300))
+            off_rows = np.sort(np.concatenate([piece[0] for piece in off]))
+            verdict.lines.append(
+                f"{label} vertices {_ranges(off_rows)} ({len(off_rows)} of the {len(rows)} that follow nodes of "
+                f"{soft_body}) are not drawn at the node they follow: vertices {_ranges(worst[0])} follow node "
+                f"{self.r.frames[worst[1]].node} {worst[2][0]:.3g} m away from it (allowed {worst[2][1]:.3g} m)")
+            verdict.diagnosed("node-order")
         return verdict
+
+    def _off_node(self, offsets: np.ndarray, frame: int) -> tuple[float, float]:
+        """How far the centre of the vertices a node holds lies from the node, and what is allowed: a drawing
+        that follows a node is drawn at it (a vertex on it, or a small sphere around it), as the rigid
+        checks ask a drawing's centre to be its shape's."""
+        centre = offsets.mean(axis=0)
+        spread = float(np.max(np.linalg.norm(offsets - centre, axis=1), initial=0.0))
+        allowed = 10 * self.tolerance.for_extents(np.array([spread]), self.pos[:1, frame])[0]
+        return float(np.linalg.norm(centre)), float(allowed)
 
     def _inertial(self, frame: int) -> np.ndarray:
         return np.asarray(self.r.frames[frame].inertial, dtype=np.float64)

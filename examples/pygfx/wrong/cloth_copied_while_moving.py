@@ -1,9 +1,14 @@
-"""A right deformable app (FURY 2): a cloth of 25 simulated nodes pinned at two corners, a box dropped
-onto it; after every step the cloth's nodes are copied into its surface actor's positions buffer
-(``getMeshData(..., flags=p.MESH_DATA_SIMULATION_MESH)``, then ``update_range()``) and the box is posed.
-The kit's tests copy it with one line changed to make wrong ones (tests/test_app_soft_bodies.py).
+"""Cloth, FURY 2, WRONG: a cloth of 25 simulated nodes pinned at two corners, and a box dropped onto it.
 
-EXPECT: pass
+pyBullet simulates the cloth as a soft body (``loadSoftBody`` of ``pybullet_data``'s ``cloth_z_up.obj``
+in a world reset with ``RESET_USE_DEFORMABLE_WORLD``, two corners anchored with ``createSoftBodyAnchor``).
+The program draws it as a surface built from the simulated nodes, ``getMeshData(cloth, -1,
+flags=p.MESH_DATA_SIMULATION_MESH)``, triangulated once while the cloth is flat, and after every step
+copies the nodes into the surface's vertices in the same order and announces them
+(``positions.update_range()``); the box is posed from its body's pose.
+
+MISTAKE: copies the cloth's nodes only when p.getBaseVelocity(cloth) says the cloth moves ("no need to rewrite a cloth at rest"); pyBullet 3.2.7 keeps no velocity for a soft body and hands back what the previous query about a rigid body left (here the box's pose, read in the same sync): the cloth is skipped at the first tick, copied while the box falls, and would freeze once the box rests
+EXPECT: fail attached skipped
 """
 import itertools
 
@@ -42,9 +47,10 @@ counter = itertools.count()
 
 
 def sync():
-    _, now = p.getMeshData(cloth, -1, flags=p.MESH_DATA_SIMULATION_MESH)
-    positions.data[:] = np.array(now, dtype=np.float32)
-    positions.update_range()
+    if np.linalg.norm(p.getBaseVelocity(cloth)[0]) > 1e-6:  # the cloth moves: copy it
+        _, now = p.getMeshData(cloth, -1, flags=p.MESH_DATA_SIMULATION_MESH)
+        positions.data[:] = np.array(now, dtype=np.float32)
+        positions.update_range()
     pos, orn = p.getBasePositionAndOrientation(box)
     box_actor.local.position = pos
     box_actor.local.rotation = orn
