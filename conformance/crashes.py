@@ -193,8 +193,7 @@ class Controller:
         message = (f"the process crashed ({how}) {place}. The run went on in a new process; this scene's other "
                    "checks with this sync fail without running it again.\n"
                    f"Where it was (faulthandler, innermost call last):\n{_stack_lines(stack)}\n"
-                   f"reproduce (in one process): pytest --pyargs conformance --sync {self.sync_spec} "
-                   f"--conformance-isolation none -k '{_test_words(crashitem)}'")
+                   f"reproduce (in one process): {_reproduce(self.sync_spec, scene, crashitem)}")
         report.longrepr = message
         report.when = "call"
         report.location = (report.location[0], None, crashitem.split("::", 1)[-1])  # the check's name as its heading
@@ -326,6 +325,17 @@ def _stack_lines(stack: str) -> str:
 
 def _check_name(nodeid: str) -> str:
     return nodeid.split("::")[-1].split("[")[0]
+
+
+def _reproduce(sync_spec: str, scene: str | None, nodeid: str) -> str:
+    """The crashed check alone, in one process, with the scene's source for a user's scene."""
+    import shlex
+
+    from conformance import own_scenes, printed
+
+    source = own_scenes.scene_arguments(scene) if scene else []
+    return shlex.join([*printed.pytest(), "--pyargs", "conformance", "--sync", sync_spec, *source,
+                       "--conformance-isolation", "none", "-k", _test_words(nodeid)])
 
 
 def _test_words(nodeid: str) -> str:

@@ -191,8 +191,8 @@ def _start_xvfb(executable: str) -> tuple[subprocess.Popen, str]:
         said = _what_went_wrong(log.read().decode("utf-8", "replace"))
         log.close()
         raise DisplayUnavailable(
-            f"Xvfb is installed but did not start (exit status {process.returncode}; it said: {said or 'nothing'}); "
-            f"{INSTALL_HINT}."
+            f"Xvfb is installed but did not start (exit status {process.returncode}; it said: {said or 'nothing'}): "
+            "what it said is what to mend, or set DISPLAY to an X server you already have and the kit uses that."
         )
     log.close()  # Xvfb keeps its own descriptor; the file disappears when it exits
     return process, f":{number}"
@@ -305,7 +305,9 @@ def _restore_sigterm_handler() -> None:
 def _xlib():
     path = ctypes.util.find_library("X11")
     if path is None:
-        raise DisplayUnavailable(f"Off-screen rendering needs the X client library libX11, which was not found; {INSTALL_HINT}.")
+        raise DisplayUnavailable("Off-screen rendering needs the X client library libX11, which was not found (the kit "
+                                 "loads it to talk to any X server, Xvfb or yours); install it with `sudo apt-get "
+                                 "install libx11-6` (Debian/Ubuntu; `dnf install libX11` on Fedora).")
     lib = ctypes.CDLL(path)
     lib.XOpenDisplay.restype = ctypes.c_void_p
     lib.XOpenDisplay.argtypes = [ctypes.c_char_p]

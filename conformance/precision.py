@@ -173,7 +173,9 @@ def rerun_command(spec: str, seed: int, factor: int, nodeid: str = "") -> str:
     from conformance.profiles import DRAW_FACTOR
 
     select = ["-k", nodeid.split("::", 1)[-1]] if nodeid else []
-    return f"{DRAW_FACTOR}={factor} " + shlex.join(["python", "-m", "pytest", "--pyargs", "conformance", "--sync", spec,
+    from conformance import printed
+
+    return f"{DRAW_FACTOR}={factor} " + shlex.join([printed.python(), "-m", "pytest", "--pyargs", "conformance", "--sync", spec,
                                                     *pytest_args(seed), *select])
 
 
@@ -222,6 +224,7 @@ def app_draws(paths, seeds, *, runs: int, jobs: int | None = None, timeout: floa
                 result = found or result
         except apps.AppFailed as err:
             draw.error = str(err)
+            draw.reproduce = apps.reproduce_command(str(path), apps.DEFAULT_TICKS)
         else:
             for check, verdict in result.verdicts.items():
                 if not verdict.passed:

@@ -67,9 +67,9 @@ def each_golden_variant(argnames: str = "scene_name, variant"):
 
 def reproduce_command(scene: str, sync: str, frames: int, params: Mapping[str, Any], events: Sequence = ()) -> str:
     """The command line that replays a run frame by frame and prints every target's error."""
-    from conformance import own_scenes
+    from conformance import own_scenes, printed
 
-    words = ["python", "-m", "conformance", "check", scene, *own_scenes.scene_arguments(scene), "--sync", sync,
+    words = [printed.python(), "-m", "conformance", "check", scene, *own_scenes.scene_arguments(scene), "--sync", sync,
              "--frames", str(frames)]
     if params:
         words += ["--params", json.dumps(dict(params), sort_keys=True)]

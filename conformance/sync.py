@@ -23,6 +23,7 @@ import os
 import sys
 import traceback
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any, Callable
 
 from conformance import crashes
@@ -182,8 +183,12 @@ def load(spec: str) -> SyncImplementation:
         if module_name.endswith(".py") or "/" in module_name or os.sep in module_name:
             # --scenes takes a file's path; --sync takes a module's name, as Python imports it.
             dotted = module_name.removesuffix(".py").replace(os.sep, ".").replace("/", ".").strip(".")
+            relative = not os.path.isabs(module_name)
+            top = module_name.replace(os.sep, "/").split("/")[0] if relative else ""
             hint = (f" --sync takes a module's dotted name, not a file's path: "
-                    f"'{dotted}:{attribute}', run from the directory that holds {module_name.split('/')[0]!r}.")
+                    + (f"'{dotted}:{attribute}', run from the directory that holds {top!r}." if relative else
+                       f"'{Path(module_name).stem}:{attribute}' with {str(Path(module_name).parent)!r} on PYTHONPATH "
+                       "(or run from there)."))
         raise SyncLoadError(
             f"sync implementation {spec!r}: importing module {module_name!r} failed with "
             f"{_exception_line(exc)}{_user_location(exc)}.{hint}"

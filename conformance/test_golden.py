@@ -50,7 +50,9 @@ def _reproduce(check: str, scene: str, sync: str, variant: dict | None = None, p
         given += ["--conformance-golden-dir", os.path.relpath(pictures.golden_dir)]
     if pictures is not None and pictures.override:
         given += ["--conformance-image-tolerance", pictures.override]
-    return shlex.join(["pytest", "--pyargs", "conformance", "-k", selected, "--sync", sync,
+    from conformance import printed
+
+    return shlex.join([*printed.pytest(), "--pyargs", "conformance", "-k", selected, "--sync", sync,
                        *(["--scenes", *source] if source else []), *given])
 
 
@@ -153,9 +155,14 @@ def test_no_stale_goldens(pictures):
 
     found = [path for paths in golden.stale_by_directory(pictures.golden_dir_for).values() for path in paths]
     if found:
+        from conformance import own_scenes, printed
+
         given = ["--golden-dir", str(pictures.golden_dir)] if pictures.golden_dir is not None else []
+        # the run's own scenes too: without them regen sees only the kit's, and would take their goldens for stale
+        sources = dict.fromkeys(w for name in scenes.names() for w in own_scenes.scene_arguments(name)[1:])
+        given += [w for source in sources for w in ("--scenes", source)]
         pytest.fail(f"{len(found)} file(s) in the golden directories are read by no check (a scene removed or renamed, "
                     f"a frame no longer golden, a stray file): {', '.join(map(str, found[:20]))}"
                     + (f" and {len(found) - 20} more" if len(found) > 20 else "")
-                    + f". Delete exactly those with: {shlex.join(['python', '-m', 'conformance', 'regen', '--prune', *given])}",
+                    + f". Delete exactly those with: {shlex.join([printed.python(), '-m', 'conformance', 'regen', '--prune', *given])}",
                     pytrace=False)

@@ -15,6 +15,8 @@ calls may be skipped between steps.
 
 from __future__ import annotations
 
+import shlex
+
 import pytest
 from hypothesis import settings, strategies as st
 from hypothesis.stateful import RuleBasedStateMachine, initialize, invariant, precondition, rule, run_state_machine_as_test
@@ -61,8 +63,14 @@ LAST_CALLS = 12
 
 
 def rerun_command(scene: str, sync: str) -> str:
-    return (f"python -m pytest --pyargs conformance -p no:randomly -k '{CHECK} and {scene}' --sync {sync} "
-            "--hypothesis-profile ci")
+    """The run of this check on this scene again, under the Hypothesis profile in force (a derandomized
+    profile replays the same programs; under the random default, Hypothesis' database replays the failing
+    one where the run was made, and its ``@reproduce_failure`` line, printed with the failure, anywhere)."""
+    from conformance import own_scenes, printed
+
+    return shlex.join([printed.python(), "-m", "pytest", "--pyargs", "conformance", "-p", "no:randomly", "-k",
+                       f"{CHECK} and {scene}", "--sync", sync, *own_scenes.scene_arguments(scene),
+                       "--hypothesis-profile", profiles._profile()])
 
 
 def machine(kit: Kit, scene_name: str) -> type[RuleBasedStateMachine]:

@@ -211,11 +211,14 @@ def resolve_sync(option: str | None, ini: Any = None, environ: Mapping[str, str]
     ``$CONFORMANCE_SYNC``, else ``reference``. ``None`` means not given; anything given, even
     empty, must be a spec (an empty ``CONFORMANCE_SYNC`` is what CI gives for an unset variable, and
     would otherwise run the reference sync: a green run that checked nothing of the user's)."""
-    if option is not None:
-        return sync_spec(option_name, option, default_hint=f"leave {option_name} out for the default, {DEFAULT_SYNC!r}")
-    if ini is not None:
-        return sync_spec("ini conformance_sync", ini, default_hint=f"remove the line for the default, {DEFAULT_SYNC!r}")
     environ = os.environ if environ is None else environ
+    if option is not None:
+        fallback = ("the ini's conformance_sync" if ini is not None else f"${SYNC_ENV_VAR}" if SYNC_ENV_VAR in environ
+                    else f"the default, {DEFAULT_SYNC!r}")
+        return sync_spec(option_name, option, default_hint=f"leave {option_name} out for {fallback}")
+    if ini is not None:
+        fallback = f"${SYNC_ENV_VAR}" if SYNC_ENV_VAR in environ else f"the default, {DEFAULT_SYNC!r}"
+        return sync_spec("ini conformance_sync", ini, default_hint=f"remove the line for {fallback}")
     if SYNC_ENV_VAR in environ:
         return sync_spec(SYNC_ENV_VAR, environ[SYNC_ENV_VAR],
                          default_hint=f"set it to a spec, or unset it for the default, {DEFAULT_SYNC!r}")

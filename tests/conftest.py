@@ -14,6 +14,13 @@ import pytest
 
 pytest_plugins = ["pytester"]
 
+# `./kit test` runs these tests with the variable `./kit` sets for its commands; the commands the kit
+# prints then name the kit's interpreter (conformance.printed). The tests read those lines as a user who
+# installed the kit where their `python` is; tests/test_printed_commands.py sets it back on purpose.
+import os  # noqa: E402
+
+os.environ.pop("CONFORMANCE_KIT_BACKEND", None)
+
 
 def pytest_collection_modifyitems(items):
     """Tests that wait for a background run go last: until then this process runs everything else

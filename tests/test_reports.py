@@ -117,6 +117,20 @@ def test_run_command_is_pytest_on_the_kit_and_says_so_in_its_exit_status(monkeyp
     assert "PytestAssertRewriteWarning" not in out + err
 
 
+def test_run_checks_the_sync_the_ini_names_as_pytest_would(monkeypatch, capfd, tmp_path):
+    """Without --sync, ``run`` leaves the choice to the plug-in (the ini's conformance_sync, then
+    $CONFORMANCE_SYNC, then reference): it used to pass --sync reference and ignore the ini."""
+    from pathlib import Path
+
+    monkeypatch.setenv("PYTHONPATH", str(Path(__file__).parent))
+    monkeypatch.delenv("CONFORMANCE_SYNC", raising=False)
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "pytest.ini").write_text("[pytest]\nconformance_sync = wrong_syncs:DoesNothing\n")
+    assert cli.main(["run", "-q", "-k", "free_fall and poses_every_frame"]) == 1
+    out, _ = capfd.readouterr()
+    assert "sync 'wrong_syncs:DoesNothing'" in out and "1 failed" in out, out[-2000:]
+
+
 def test_verdicts_runs_in_survey_mode_and_kill_rate_stops_at_the_first_failure(monkeypatch, capsys):
     argv = verdicts.command("s", survey=True, report="r.json", results="pics")
     assert "--conformance-survey" in argv and argv[argv.index("--conformance-results") + 1] == "pics"

@@ -37,6 +37,29 @@ def test_the_check_names_every_file_no_check_reads(pytester, goldens):
     assert f"python -m conformance regen --prune --golden-dir {goldens}" in out
 
 
+def test_the_prune_line_keeps_the_runs_own_scenes_and_deletes_only_the_strays(pytester, goldens):
+    """With an own scene in the run, the printed prune names its source: without it `regen` sees only the
+    kit's scenes and would take the own scene's goldens for stale."""
+    import shlex
+
+    from test_own_scenes import _example
+
+    pytester.makepyfile(my_scenes=_example())
+    own = goldens / "tossed_die"
+    own.mkdir()
+    (own / "frame-0000.png").write_bytes(b"a golden of the own scene")
+    result = pytester.runpytest_subprocess("--pyargs", "conformance", "-p", "no:cacheprovider", "-k", "test_no_stale_goldens",
+                                           "--conformance-golden-dir", str(goldens), "--scenes", "my_scenes.py")
+    out = result.stdout.str()
+    line = next(line for line in out.splitlines() if "Delete exactly those with:" in line)
+    command = line.split("Delete exactly those with: ", 1)[1].strip()
+    assert "--scenes my_scenes.py" in command, command
+    done = subprocess.run([sys.executable, *shlex.split(command)[1:]], cwd=pytester.path, capture_output=True,
+                          text=True, timeout=600)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert (own / "frame-0000.png").exists() and not any((goldens / name).exists() for name in STRAYS)
+
+
 def test_the_shipped_goldens_have_nothing_stale():
     from conformance import scenes
 

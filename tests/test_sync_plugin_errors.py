@@ -39,6 +39,8 @@ def _assert_clean_usage_error(result, *needles: str) -> None:
         (":Sync", ["neither a short name"]),
         # Issue 30, point 10: a path, as --scenes takes, said only "No module named 'mysim/sync'".
         ("mysim/sync.py:MySync", ["not a file's path: 'mysim.sync:MySync'", "the directory that holds 'mysim'"]),
+        # An absolute path has no directory to run from that the dotted name could start at.
+        ("/tmp/mysim/sync.py:MySync", ["'sync:MySync' with '/tmp/mysim' on PYTHONPATH"]),
     ],
 )
 def test_unloadable_spec_is_a_usage_error(pytester, spec, needles):

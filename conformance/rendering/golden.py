@@ -81,9 +81,9 @@ def regen_command(scene: str, directory: Path | str | None = None) -> str:
     """The whole command that (re)makes a scene's goldens in ``directory`` (all its frames together:
     they share one run): with ``--scenes`` for a user's scene and ``--golden-dir`` unless ``directory``
     is where the scene's goldens live by default."""
-    from conformance import own_scenes
+    from conformance import own_scenes, printed
 
-    words = ["python", "-m", "conformance", "regen", scene, *own_scenes.scene_arguments(scene)]
+    words = [printed.python(), "-m", "conformance", "regen", scene, *own_scenes.scene_arguments(scene)]
     if directory is not None and Path(directory).resolve() != own_scenes.golden_dir(scene).resolve():
         words += ["--golden-dir", os.path.relpath(Path(directory).resolve())]
     return shlex.join(words)
