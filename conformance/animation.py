@@ -71,12 +71,14 @@ def _ratio(error: float, tolerance: float) -> float:
     return error / tolerance if tolerance else (math.inf if error else 0.0)
 
 
-def check_frame(run, frame: int) -> FrameCheck:
-    """Check ``run`` (a :class:`conformance.runner.Run`) as it stands at ``frame``."""
+def check_frame(run, frame: int, tolerance=None) -> FrameCheck:
+    """Check ``run`` (a :class:`conformance.runner.Run`) as it stands at ``frame`` (to ``tolerance``, by
+    default the kit's)."""
     from conformance import compare
 
-    vertices = compare.compare_vertices(run.drawing, frame)
-    normals = compare.compare_normals(run.drawing, frame)
+    tolerance = tolerance or compare.DEFAULT
+    vertices = compare.compare_vertices(run.drawing, frame, tolerance)
+    normals = compare.compare_normals(run.drawing, frame, tolerance)
     ranked = [(_ratio(r.error, r.tolerance), r.describe()) for r in vertices if not r.ok]
     ranked += [(_ratio(r.angle, r.tolerance), r.describe()) for r in normals if not r.ok]
     unannounced = [f"actor {name!r}: {missed}" for f, name, missed in run.unannounced if f == frame]
@@ -214,7 +216,8 @@ class Animation:
 
 
 def record(scene: str, implementation, frames: range, out: Path, *, size: tuple[int, int] | None = None,
-           events: Iterable[Any] = (), params: dict | None = None, show_progress: bool = True) -> Animation:
+           events: Iterable[Any] = (), params: dict | None = None, show_progress: bool = True,
+           tolerance=None) -> Animation:
     """Run ``scene`` with ``implementation`` (a loaded sync), check and render each frame of ``frames``,
     and write the animation to ``out``. Needs a display (:func:`conformance.display.ensure_display`)."""
     from conformance import backends, files, runner
@@ -229,7 +232,7 @@ def record(scene: str, implementation, frames: range, out: Path, *, size: tuple[
         chosen = progress(frames, total=len(frames), what=f"{scene} → {out.name}") if show_progress else frames
         for frame in chosen:
             run.advance(frame - run.frame)
-            check = check_frame(run, frame)
+            check = check_frame(run, frame, tolerance)
             animation.checks.append(check)
             picture = backends.render(run.drawing, run.scene.camera, size)
             if check.misplaced:

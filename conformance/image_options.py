@@ -90,7 +90,7 @@ class Pictures:
 
     # -- the session's side -------------------------------------------------------------------
     def describe(self) -> str:
-        where = ("each scene's own (the kit's; yours in golden/ beside your scene file)" if self.golden_dir is None
+        where = ("each scene's own (the kit's; yours in golden/<backend>/ beside your scene file)" if self.golden_dir is None
                  else str(self.golden_dir))
         tolerance = ("auto (the sync against a live reference render: same-renderer; the live reference against "
                      "the golden: same-renderer for goldens this machine's renderer made or that it equals, else other-renderer)"

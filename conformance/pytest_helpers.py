@@ -65,12 +65,32 @@ def each_golden_variant(argnames: str = "scene_name, variant"):
     return pytest.mark.parametrize(argnames, params)
 
 
-def reproduce_command(scene: str, sync: str, frames: int, params: Mapping[str, Any], events: Sequence = ()) -> str:
-    """The command line that replays a run frame by frame and prints every target's error."""
+def tolerance_arguments(tolerance) -> list[str]:
+    """The ``--conformance-…`` options that give ``tolerance`` where it is not the kit's default."""
+    from conformance.tolerances import DEFAULT
+
+    fields = ("size_rtol", "position_rtol", "atol", "normal_angle")
+    return [w for name in fields if tolerance is not None and getattr(tolerance, name) != getattr(DEFAULT, name)
+            for w in (f"--conformance-{name.replace('_', '-')}", repr(getattr(tolerance, name)))]
+
+
+def rerun_check(check_id: str, scene: str, sync: str, tolerance=None, given: Sequence[str] = ()) -> str:
+    """The pytest command that runs the check ``check_id`` (its whole id: ``test_x[scene]``) again, with the
+    scene's source for a user's scene, the tolerance of this run, and the options ``given``."""
+    from conformance import own_scenes, printed
+
+    return shlex.join([*printed.pytest(), "--pyargs", "conformance", "-k", check_id, "--sync", sync,
+                       *own_scenes.scene_arguments(scene), *tolerance_arguments(tolerance), *given])
+
+
+def reproduce_command(scene: str, sync: str, frames: int, params: Mapping[str, Any], events: Sequence = (),
+                      tolerance=None) -> str:
+    """The command line that replays a run frame by frame and prints every target's error (the vertex
+    checks': vertices, normals and announcements), to ``tolerance`` when it is not the kit's."""
     from conformance import own_scenes, printed
 
     words = [printed.python(), "-m", "conformance", "check", scene, *own_scenes.scene_arguments(scene), "--sync", sync,
-             "--frames", str(frames)]
+             "--frames", str(frames), *tolerance_arguments(tolerance)]
     if params:
         words += ["--params", json.dumps(dict(params), sort_keys=True)]
     if events:
@@ -117,7 +137,7 @@ def _drawn(run: Any, results: Sequence[Any]) -> dict[str, Any]:
     return diagnosis.drawn_now(run, {r.target for r in results}, results[0].frame)
 
 
-def _vertices_message(failures: Sequence[Any], run: Any, sync: str, worst: Any = None, drawn=None) -> str:
+def _vertices_message(failures: Sequence[Any], run: Any, sync: str, worst: Any = None, drawn=None, tolerance=None) -> str:
     """The message of a frame's vertex failures, about ``worst`` (default: the largest error, NaN first),
     with the known mistake that explains its drawing (``drawn``: :func:`_drawn`), if one does."""
     if worst is None:
@@ -130,17 +150,18 @@ def _vertices_message(failures: Sequence[Any], run: Any, sync: str, worst: Any =
     if len(failures) > 1:
         others = ", ".join(sorted({r.target for r in failures} - {worst.target}))
         lines.append(f"{len(failures)} targets out of tolerance at this frame" + (f" (also: {others[:300]})" if others else ""))
-    lines.append("reproduce: " + reproduce_command(run.scene.name, sync, worst.frame, run.params, run.events))
+    lines.append("reproduce: " + reproduce_command(run.scene.name, sync, worst.frame, run.params, run.events, tolerance))
     return "\n".join(lines)
 
 
-def _normals_message(failures: Sequence[Any], run: Any, sync: str) -> str:
+def _normals_message(failures: Sequence[Any], run: Any, sync: str, tolerance=None) -> str:
     """The message of a frame's normals failures, with the known mistake that explains the worst (made
     from the run as it stands: call it at the failing frame, as survey mode's ``note`` does)."""
     worst = max(failures, key=lambda r: r.angle)
     found = diagnosis.diagnose_normals(run, worst)
     return "\n".join([f"{worst.describe()} {_context(run, sync, worst.frame)}", *([found] if found else []),
-                      "reproduce: " + reproduce_command(run.scene.name, sync, worst.frame, run.params, run.events)])
+                      "reproduce: " + reproduce_command(run.scene.name, sync, worst.frame, run.params, run.events,
+                                                        tolerance)])
 
 
 def _unannounced_message(frame: int, actor: str, missed: str, run: Any, sync: str) -> str:
@@ -264,10 +285,11 @@ class Kit:
             drawn = functools.lru_cache(maxsize=None)(lambda: _drawn(run, [worst, _largest(failures)]))
             # The figure is the worst in tolerances, and so is its message; the first failure's message
             # stays default mode's own (about the largest error in metres).
-            first = _vertices_message(failures, run, sync, drawn=drawn()) if self.survey is None else None
+            first = _vertices_message(failures, run, sync, drawn=drawn(), tolerance=self.tolerance) if self.survey is None else None
             self._picture(run, failures, first, drawn)
-            self._failed("vertices", lambda w=worst: _vertices_message(failures, run, sync, w, drawn()),
-                         first=(lambda: first) if first is not None else (lambda: _vertices_message(failures, run, sync, drawn=drawn())),
+            self._failed("vertices", lambda w=worst: _vertices_message(failures, run, sync, w, drawn(), self.tolerance),
+                         first=(lambda: first) if first is not None else (
+                             lambda: _vertices_message(failures, run, sync, drawn=drawn(), tolerance=self.tolerance)),
                          value=worst.error, limit=worst.tolerance, unit="m", frame=worst.frame, target=worst.target)
         normals = compare.compare_normals(run.drawing, run.frame, self.tolerance)
         if normals:
@@ -283,7 +305,7 @@ class Kit:
         turned = [r for r in normals if not r.ok]
         if turned:
             worst = max(turned, key=lambda r: (r.angle / r.tolerance if r.tolerance else r.angle))
-            self._failed("normals", lambda: _normals_message(turned, run, sync), value=worst.angle,
+            self._failed("normals", lambda: _normals_message(turned, run, sync, self.tolerance), value=worst.angle,
                          limit=worst.tolerance, unit="rad", frame=worst.frame, target=worst.target)
         seen = self._announced.get(run, 0)
         for frame, actor, missed in run.unannounced[seen:]:
@@ -299,7 +321,7 @@ class Kit:
         if message is None:  # survey mode: the first failure's words, made only if its picture is kept
             if self._node is None or misplaced.PICTURE in self._node.stash:
                 return
-            message = _vertices_message(failures, run, self.sync, drawn=drawn())
+            message = _vertices_message(failures, run, self.sync, drawn=drawn(), tolerance=self.tolerance)
         misplaced.note(self._node, run, failures, worst, sync=self.sync, message=message, first=self.survey is not None)
 
     def fail(self, kind: str, message: str, *, exception: type[BaseException] | None = None, **numbers: Any) -> None:

@@ -40,9 +40,8 @@ def _reproduce(check: str, scene: str, sync: str, variant: dict | None = None, p
     verdict: the user's scenes, and the golden directory and image tolerance given."""
     import os
 
-    from conformance import own_scenes
+    from conformance.pytest_helpers import rerun_check
 
-    source = own_scenes.scene_arguments(scene)[1:]
     # The whole id, brackets included: "mixed_shapes" alone would select its variants' checks too.
     selected = f"{check}[{scene}-{variant_id(variant)}]" if variant else f"{check}[{scene}]"
     given = []
@@ -50,10 +49,7 @@ def _reproduce(check: str, scene: str, sync: str, variant: dict | None = None, p
         given += ["--conformance-golden-dir", os.path.relpath(pictures.golden_dir)]
     if pictures is not None and pictures.override:
         given += ["--conformance-image-tolerance", pictures.override]
-    from conformance import printed
-
-    return shlex.join([*printed.pytest(), "--pyargs", "conformance", "-k", selected, "--sync", sync,
-                       *(["--scenes", *source] if source else []), *given])
+    return rerun_check(selected, scene, sync, given=given)
 
 
 def _goldens(pictures, scene, params=None):
@@ -100,8 +96,8 @@ def test_golden_render(scene_name, variant, kit, pictures, request):
             from conformance.pytest_helpers import reproduce_command
 
             blamed = [f"{reftest.bodies_where_pixels_differ(scene_name, golden, variant, references[frame], drawn[frame])}"
-                      f" [{scene_name}, frame {frame}]; the mistake, frame by frame: "
-                      f"{reproduce_command(scene_name, kit.sync, max(frame, 1), variant)}"]
+                      f" [{scene_name}, frame {frame}]; the vertices, frame by frame (a mistake there is named): "
+                      f"{reproduce_command(scene_name, kit.sync, max(frame, 1), variant, tolerance=kit.tolerance)}"]
         record.details["physics"] = physics[frame].as_dict()
         record.reproduce = _reproduce("test_golden_render", scene_name, kit.sync, variant, pictures)
         record.nodeid = request.node.nodeid

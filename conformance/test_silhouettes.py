@@ -15,23 +15,25 @@ from hypothesis import given, strategies as st
 from conformance import backends, image_options, scenes, shared_run, strategies
 from conformance.events import Teleport
 from conformance.profiles import check_settings
-from conformance.pytest_helpers import _context, each_scene, reproduce_command
+from conformance.pytest_helpers import _context, each_scene, reproduce_command, rerun_check
 from conformance.rendering import framing, golden, silhouettes
 
-def silhouette_check(run, sync: str, pictures=None, nodeid: str = ""):
+def silhouette_check(run, sync: str, pictures=None, nodeid: str = "", check: str = "test_silhouettes_match_in_any_orientation",
+                     tolerance=None):
     """FURY's ID render against pyBullet's mask for the run's current frame, as an ImageCheck (kept,
-    with its masks when it failed, in the results directory when ``pictures`` is given)."""
+    with its masks when it failed, in the results directory when ``pictures`` is given); its reproduce
+    line runs ``check`` (a whole pytest id, or a check's name) again."""
     scene = run.scene
     ids_fury = backends.render_ids(run.drawing, scene.camera, scene.image_size)
     ids_bullet = silhouettes.pybullet_mask(scene, scene.bindings, scene.camera, scene.image_size)
-    record = _record(run, sync, ids_fury, ids_bullet)
+    record = _record(run, sync, ids_fury, ids_bullet, check, tolerance)
     record.nodeid = nodeid
     if pictures is not None:
         pictures.keep(record, silhouettes.mask_images(ids_fury, ids_bullet))
     return record
 
 
-def _record(run, sync: str, ids_fury, ids_bullet):
+def _record(run, sync: str, ids_fury, ids_bullet, check: str, tolerance=None):
     scene = run.scene
     record = silhouettes.compare_silhouettes(
         ids_fury, ids_bullet, min_iou=silhouettes.thresholds(scene.bindings), rounding=silhouettes.roundings(scene.bindings),
@@ -41,14 +43,18 @@ def _record(run, sync: str, ids_fury, ids_bullet):
         touching=silhouettes.touching_pairs(scene, scene.bindings, ids_fury, ids_bullet))
     record.sync = sync
     record.params = golden.jsonable(dict(run.params))
-    record.reproduce = reproduce_command(scene.name, sync, run.frame, run.params, run.events)
+    # The check itself reruns it (`check` compares vertices, not silhouettes); the frame-by-frame replay
+    # of the same run shows whether its vertices are wrong too.
+    record.reproduce = rerun_check(check, scene.name, sync, tolerance)
+    record.details["replay"] = reproduce_command(scene.name, sync, run.frame, run.params, run.events, tolerance)
     return record
 
 
 def assert_passed(record, run, sync: str) -> None:
     __tracebackhide__ = True
     if not record.passed:
-        pytest.fail(f"{record.message} {_context(run, sync, run.frame)}\nreproduce: {record.reproduce}", pytrace=False)
+        pytest.fail(f"{record.message} {_context(run, sync, run.frame)}\nreproduce: {record.reproduce}\n"
+                    f"the same run's vertices, frame by frame: {record.details['replay']}", pytrace=False)
 
 
 #: Where the watcher of the golden-frame check leaves its records (and a failure's pictures) for the check.
@@ -62,13 +68,15 @@ def _silhouettes(run, kit):
     scene = run.scene
     ids_fury = backends.render_ids(run.drawing, scene.camera, scene.image_size)
     ids_bullet = silhouettes.pybullet_mask(scene, scene.bindings, scene.camera, scene.image_size)
-    record = _record(run, kit.sync, ids_fury, ids_bullet)
+    record = _record(run, kit.sync, ids_fury, ids_bullet, f"test_silhouettes_match_pybullet_at_golden_frames[{scene.name}]",
+                     kit.tolerance)
     config = kit._node.config  # None outside a pytest session: nothing is kept then but failures
     keep = not record.passed or (config is not None and image_options.from_config(config).keep_passing)
     kit._node.stash.setdefault(_SEEN, []).append((record, silhouettes.mask_images(ids_fury, ids_bullet) if keep else {}))
     if not record.passed:
         worst = max(record.details["targets"], key=lambda t: t["off"] / max(t["allowed_off"], 1))
-        kit.fail("silhouette", f"{record.message} {_context(run, kit.sync, run.frame)}\nreproduce: {record.reproduce}",
+        kit.fail("silhouette", f"{record.message} {_context(run, kit.sync, run.frame)}\nreproduce: {record.reproduce}\n"
+                 f"the same run's vertices, frame by frame: {record.details['replay']}",
                  value=worst["off"], limit=worst["allowed_off"], unit="pixels off", frame=run.frame,
                  target=worst["target"])
 
@@ -122,6 +130,6 @@ def test_silhouettes_match_in_any_orientation(kit):
     def check(scene_name, turns):
         events = [Teleport(0, which, (0.0, 0.0, 0.0), orientation) for which, orientation in turns]
         with kit.run(scene_name, events=events) as run:
-            assert_passed(silhouette_check(run, kit.sync), run, kit.sync)
+            assert_passed(silhouette_check(run, kit.sync, tolerance=kit.tolerance), run, kit.sync)
 
     check()

@@ -193,7 +193,7 @@ def machine(kit: Kit, scene_name: str) -> type[RuleBasedStateMachine]:
         @rule()
         def render(self):
             self.calls.append("render()")
-            record = silhouette_check(self.run, kit.sync)
+            record = silhouette_check(self.run, kit.sync, check=f"{CHECK}[{scene_name}]", tolerance=kit.tolerance)
             if not record.passed:
                 self.fail("silhouette", f"{record.message} {_context(self.run, kit.sync, self.run.frame)}")
 

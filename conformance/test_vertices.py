@@ -16,7 +16,7 @@ from hypothesis import example, given, strategies as st
 from conformance import backends, compare, figures, profiles, scenes, shared_run, strategies
 from conformance.events import turning_everything
 from conformance.profiles import check_settings
-from conformance.pytest_helpers import _context, bounds_figure, each_scene, reproduce_command
+from conformance.pytest_helpers import _context, bounds_figure, each_scene, rerun_check
 
 
 def _scene_runs(scene_name: str, longest: int):
@@ -207,7 +207,7 @@ def _bounds(run, kit):
         return
     for failure in (r for r in compare.compare_bounds(run.drawing, run.frame, kit.tolerance) if not r.ok):
         kit.fail("bounds", f"{failure.target!r}: {'; '.join(failure.problems)} {_context(run, kit.sync, run.frame)}\n"
-                 f"reproduce: {reproduce_command(run.scene.name, kit.sync, run.frame, run.params)}",
+                 f"reproduce: {rerun_check(f'test_drawn_bounds_agree_with_get_aabb[{run.scene.name}]', run.scene.name, kit.sync, kit.tolerance)}",
                  frame=run.frame, target=failure.target, **bounds_figure(failure.problems))
 
 

@@ -147,7 +147,7 @@ def test_image_checks_alone_fail_a_wrong_sync_end_to_end(tmp_path):
     # Issue 30, point 5: the golden failure names the bodies whose pixels differ and the command that
     # names the mistake (it said only "12514 px differ, 39 allowed").
     named = re.search(r"where the pixels differ, pyBullet's poses put '(brick_\d+|ball)' \(\d+ px\).*?"
-                      r"the mistake, frame by frame: (python -m conformance check brick_wall_single .*)", run.stdout)
+                      r"the vertices, frame by frame \(a mistake there is named\): (python -m conformance check brick_wall_single .*)", run.stdout)
     assert named, run.stdout[-3000:]
     replay = subprocess.run([sys.executable, *shlex.split(named.group(2))[1:]], cwd=tmp_path, env=env,
                             capture_output=True, text=True, timeout=600)

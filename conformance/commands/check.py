@@ -7,7 +7,7 @@ with the failing frames marked (the same frame check: :func:`conformance.animati
 from __future__ import annotations
 
 from conformance import validation
-from conformance.commands.common import params
+from conformance.commands.common import add_tolerance_arguments, params, tolerance_of
 
 NAME = "check"
 HELP = "replay a scene with a sync and print errors frame by frame"
@@ -23,6 +23,7 @@ def add_arguments(parser) -> None:
     parser.add_argument("--params", default=None, help="scene parameters as a JSON object")
     parser.add_argument("--events", default=None, help="teleports, joint resets and kicks as JSON (from a failure)")
     parser.add_argument("-v", "--verbose", action="store_true", help="print every frame, not only failing ones")
+    add_tolerance_arguments(parser)
 
 
 def run(args, extra) -> int:
@@ -36,12 +37,13 @@ def run(args, extra) -> int:
     replayed = events.loads(args.events) if args.events is not None else []
     args.sync = validation.resolve_sync(args.sync_given)
     implementation = sync.load(args.sync)
+    tolerance = tolerance_of(args)
     first_failure = None
     with runner.running(args.scene, implementation, events=replayed, **scene_params) as run:
         for frame in range(frames + 1):
             if frame:
                 run.advance()
-            check = check_frame(run, frame)
+            check = check_frame(run, frame, tolerance)
             if check.problems or args.verbose:
                 print(f"frame {frame}: {len(check.problems)} problems; worst vertex: {check.worst_vertex}")
                 for line in check.problems[:5]:

@@ -8,7 +8,29 @@ from pathlib import Path
 from conformance.errors import ConformanceError
 from conformance.files import write_atomically
 
-__all__ = ["add_backend_run_arguments", "emit", "params", "replace_block"]
+__all__ = ["add_backend_run_arguments", "add_tolerance_arguments", "emit", "params", "replace_block", "tolerance_of"]
+
+#: The vertex tolerance's fields a command takes, spelled as the pytest plug-in's ``--conformance-…``
+#: options, so that a reproduce line carries the tolerance its run used (``check``, ``render``).
+TOLERANCES = ("size_rtol", "position_rtol", "atol", "normal_angle")
+
+
+def add_tolerance_arguments(parser) -> None:
+    for name in TOLERANCES:
+        parser.add_argument(f"--conformance-{name.replace('_', '-')}", dest=name, default=None, metavar="X",
+                            help=f"the vertex checks' {name} (default: the kit's)")
+
+
+def tolerance_of(args):
+    """The tolerance the command's options give (the kit's default where they give none)."""
+    import dataclasses
+
+    from conformance import validation
+    from conformance.tolerances import DEFAULT
+
+    given = {name: validation.finite_non_negative(f"--conformance-{name.replace('_', '-')}", getattr(args, name))
+             for name in TOLERANCES if getattr(args, name) is not None}
+    return dataclasses.replace(DEFAULT, **given)
 
 
 def params(text: str | None) -> dict:

@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from conformance import validation
-from conformance.commands.common import params
+from conformance.commands.common import add_tolerance_arguments, params, tolerance_of
 from conformance.errors import BadArgument
 
 NAME = "render"
@@ -35,6 +35,7 @@ def add_arguments(parser) -> None:
                         help="sync implementation (default: $CONFORMANCE_SYNC, else reference)")
     parser.add_argument("--params", default=None, help="scene parameters as a JSON object")
     parser.add_argument("--events", default=None, help="teleports, joint resets and kicks as JSON (from a failure)")
+    add_tolerance_arguments(parser)
     parser.add_argument("--size", nargs=2, metavar=("W", "H"), default=None, help="picture size in pixels")
     parser.add_argument("--out", default=None, help="PNG path for one scene (default: OUT_DIR/SCENE-stepN.png)")
     parser.add_argument("--out-dir", default=None, help="directory for the PNGs (default: the current directory)")
@@ -56,6 +57,7 @@ class _Request:
     size: tuple[int, int] | None = None
     params: dict = field(default_factory=dict)
     events: list = field(default_factory=list)
+    tolerance: Any = None
     step: int | None = None
     out: Path | None = None
     out_dir: Path | None = None
@@ -85,6 +87,7 @@ def _validated(args) -> _Request:
         request.size = validation.image_size("--size", args.size)
     request.params = params(args.params)
     request.events = events.loads(args.events) if args.events is not None else []
+    request.tolerance = tolerance_of(args)
     if args.gif is not None:
         why = "--gif writes one animation; choose its frames with --frames A:B:S"
         for flag, value in (("--step", args.step), ("--out", args.out), ("--out-dir", args.out_dir)):
@@ -141,7 +144,7 @@ def _animate(request: _Request) -> int:
 
     name, frames = request.names[0], request.frames
     made = animation.record(name, request.implementation, frames, request.gif, size=request.size,
-                            events=request.events, params=request.params)
+                            events=request.events, params=request.params, tolerance=request.tolerance)
     for check in made.failing[:MAX_LISTED]:
         print(f"frame {check.frame}: {len(check.problems)} problems; worst: {check.worst_problem}")
     if len(made.failing) > MAX_LISTED:

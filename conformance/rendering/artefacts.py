@@ -127,7 +127,7 @@ def write_artefacts(record: ImageCheck, results_dir: str | os.PathLike,
     """Write every picture given for ``record`` and append the record to this process's records file.
 
     What a check keeps is the caller's choice (the plugin gives a failure all its pictures, a pass
-    none unless ``--keep-passing`` asks): every record is appended, pictures or not, so the report
+    none unless ``--conformance-keep-passing`` asks): every record is appended, pictures or not, so the report
     shows every image check of the run. ``record.images`` is updated in place with the paths written
     (relative to ``results_dir``), and the record returned.
     """
