@@ -46,7 +46,7 @@ def run(args, extra) -> int:
         import shlex
 
         made_by = shlex.join(["python", "-m", "conformance", "kill-rate", *[part for module in args.wrong for part in ("--wrong", module)], "--right", args.right,
-                              "--matrix", str(args.matrix), *(["--", *extra] if extra else [])])
+                              "--matrix", str(args.matrix), *[w for source in args.scenes for w in ("--scenes", source)], *(["--", *extra] if extra else [])])
         text_matrix = f"# Kill matrix, {backends.describe()}\n\nMade by `{made_by}`.\n\n{kill_matrix.markdown(outcomes)}\n"
         write_atomically(args.matrix, text_matrix.encode("utf-8"))
     if args.json:

@@ -71,6 +71,7 @@ def run(args, extra) -> int:
     made_by = shlex.join(["python", "-m", "conformance", "precision", *args.specs,
                           *[part for module in args.right for part in ("--right", module)],
                           *[part for pattern in args.apps for part in ("--apps", pattern)],
+                          *[w for source in args.scenes for w in ("--scenes", source)],
                           "--seeds", str(args.seeds), *(["--right-seeds", str(args.right_seeds)] if args.right_seeds else []),
                           *(["--app-seeds", str(args.app_seeds)] if args.app_seeds else []),
                           "--first-seed", str(args.first_seed), "--factor", str(args.factor),

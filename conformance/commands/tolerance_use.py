@@ -30,15 +30,19 @@ def run(args, extra) -> int:
     for spec in specs:  # a spec that cannot load fails now, in one paragraph
         sync.load(spec)
     outcomes = verdicts.check_all(specs, pytest_args=extra, jobs=args.jobs)
+    from conformance import printed
+
+    sources = [w for source in args.scenes for w in ("--scenes", source)]
     failed = [o.spec for o in outcomes if not o.passed]
     if failed:
         # A figure from a failing sync says nothing about what a right one needs.
         print(f"error: {', '.join(failed)} failed the checks, so it is not a right sync and its figures are not "
-              f"counted; run `python -m conformance verdicts {' '.join(failed)}` to see why.")
+              f"counted; run `{shlex.join([printed.python(), '-m', 'conformance', 'verdicts', *failed, *sources, *(['--', *extra] if extra else [])])}` "
+              "to see why.")
         return 1
     worst = tolerance_use.worst_uses(u for o in outcomes for u in tolerance_use.uses(o.spec, o.records, o.images))
     made_by = shlex.join(["python", "-m", "conformance", "tolerance-use", *args.specs,
-                          *[part for module in args.right for part in ("--right", module)],
+                          *[part for module in args.right for part in ("--right", module)], *sources,
                           *(["--", *extra] if extra else [])])
     emit(f"### Tolerance use, {backends.describe()}\n\nMade by `{made_by}` ({len(specs)} right syncs, "
          f"Hypothesis profile {verdicts.PROFILE} unless given).\n\n{tolerance_use.markdown(worst)}", args.out)
