@@ -40,6 +40,8 @@ _VERDICT_KEY = pytest.StashKey[dict]()
 _RECORDS_KEY = pytest.StashKey[list]()
 #: How many checks of each scene the session selected (not known in pytest-xdist's controller, which collects nothing).
 _SELECTED_KEY = pytest.StashKey[dict]()
+#: per scene, how many of its checks -k or -m left out: its PASS then covers the selected ones only
+_DESELECTED_KEY = pytest.StashKey[dict]()
 #: The name under which each check's record rides on its report (``report.user_properties``).
 _RECORD_PROPERTY = "conformance_record"
 
@@ -509,6 +511,16 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus) -> None:
     write_atomically(path, json.dumps(payload, indent=1, default=float).encode("utf-8"))  # never half a report
 
 
+def pytest_deselected(items) -> None:
+    if not items:
+        return
+    kept = items[0].config.stash.setdefault(_DESELECTED_KEY, {})
+    for item in items:
+        marker = item.get_closest_marker("scene")
+        if marker is not None:
+            kept[marker.args[0]] = kept.get(marker.args[0], 0) + 1
+
+
 def pytest_collection_finish(session: pytest.Session) -> None:
     if not session.items:
         return
@@ -520,6 +532,7 @@ def pytest_collection_finish(session: pytest.Session) -> None:
     session.config.stash[_SELECTED_KEY] = dict(counts)
     if hasattr(session.config, "workeroutput"):  # for the pytest-xdist controller, which prints the verdicts
         session.config.workeroutput["conformance_selected"] = dict(counts)
+        session.config.workeroutput["conformance_deselected"] = dict(session.config.stash.get(_DESELECTED_KEY, {}))
 
 
 @pytest.hookimpl(optionalhook=True)
@@ -531,6 +544,9 @@ def pytest_testnodedown(node, error) -> None:
         kept = node.config.stash.setdefault(_SELECTED_KEY, {})
         for scene, count in counts.items():
             kept[scene] = max(kept.get(scene, 0), count)
+    for scene, count in getattr(node, "workeroutput", {}).get("conformance_deselected", {}).items():
+        left_out = node.config.stash.setdefault(_DESELECTED_KEY, {})
+        left_out[scene] = max(left_out.get(scene, 0), count)
 
 
 def _scene_verdict(outcomes: dict, selected: int | None, stopped: bool) -> tuple[str, str]:
@@ -570,5 +586,8 @@ def pytest_terminal_summary(terminalreporter, exitstatus, config: pytest.Config)
                 for s in scenes)
     for scene in scenes:
         verdict, detail = _scene_verdict(verdicts.get(scene, {}), selected.get(scene) if selected is not None else None, stopped)
+        left_out = config.stash.get(_DESELECTED_KEY, {}).get(scene, 0)
+        if left_out:  # a PASS of the checks that were asked for, not of the scene
+            detail += f"; {left_out} of its checks not selected (-k, -m)"
         tr.write_line(f"{verdict:{max(words, 4)}}  {scene:<{width}}  {detail}", red=verdict == "FAIL",
                       yellow=verdict in ("INCOMPLETE", "NOT RUN"), green=verdict == "PASS")

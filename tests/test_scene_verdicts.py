@@ -52,3 +52,13 @@ def test_a_whole_run_calls_its_scenes_pass(table):
     assert result.ret == pytest.ExitCode.OK, text
     assert rows == {scene: ("PASS", rows[scene][1]) for scene in ("free_fall", "chain", "sliding_box")}, text
     assert all("not run" not in detail for _, detail in rows.values()), text
+
+
+def test_a_pass_of_some_checks_of_a_scene_says_the_others_were_not_selected(table):
+    """A -k that selects a few of a scene's checks: PASS is for those, and the line says so."""
+    # the last -k is pytest's: it replaces the fixture's, so it names the scenes again
+    result, rows, text = table("--sync", "reference", "-k", f"test_vertices_match_poses_every_frame and ({SCENES})")
+    assert result.ret == pytest.ExitCode.OK, text
+    assert set(rows) == {"free_fall", "chain", "sliding_box"}, text
+    assert all(verdict == "PASS" and "1 passed" in detail and "of its checks not selected (-k, -m)" in detail
+               for verdict, detail in rows.values()), text
