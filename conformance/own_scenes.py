@@ -111,7 +111,16 @@ def load(source: str, *, relative_to: Path | str | None = None) -> list[str]:
     if not names:
         raise BadArgument(f"scene source {source!r} ({getattr(module, '__file__', module)}) defines no SceneSpec; "
                           "give it one at module level, e.g. SPEC = SceneSpec(name='my_scene', …)")
+    # What loaded them, as it can be given again: the file for a path, the module's name for a module (a
+    # package's module re-imported as a file would lose its relative imports).
+    given = str(Path(module.__file__).resolve()) if _is_path(source) and getattr(module, "__file__", None) else source
+    for name in names:
+        _LOADED_FROM.setdefault(name, given)
     return names
+
+
+#: Each own scene's source, as it was loaded (``load``): what a printed command gives ``--scenes``.
+_LOADED_FROM: dict[str, str] = {}
 
 
 def _module_of(spec) -> str | None:
@@ -149,9 +158,14 @@ def export(given: Iterable[str], *, relative_to: Path | str | None = None) -> No
 
 
 def source_of(name: str) -> str | None:
-    """The file that defines scene ``name`` (its ``populate``), or None for the kit's own scenes."""
+    """The scene source that registered scene ``name`` (the file or module given to ``--scenes``, the
+    ini or ``$CONFORMANCE_SCENES``), else the file that defines its ``populate``; None for the kit's own
+    scenes. Not ``populate``'s file first: a scene file may import its ``populate`` from a helper module,
+    which defines no SceneSpec."""
     from conformance import scenes
 
+    if name in _LOADED_FROM:
+        return _LOADED_FROM[name]
     populate = scenes.get(name).populate
     if (getattr(populate, "__module__", "") or "").startswith(scenes.__name__ + "."):
         return None  # the kit's (in a checkout and in a wheel alike: the package conformance.scenes)
@@ -166,6 +180,8 @@ def scene_arguments(name: str) -> list[str]:
     source = source_of(name)
     if source is None:
         return []
+    if not _is_path(source):
+        return ["--scenes", source]  # a module's name, as it was given
     try:
         source = os.path.relpath(source)
     except ValueError:  # another drive (Windows)

@@ -207,3 +207,20 @@ def test_pytest_refuses_a_bad_source_before_collecting(tmp_path):
     run = _run(tmp_path, "-m", "pytest", "--pyargs", "conformance", "-p", "no:cacheprovider",
                "--conformance-scenes", "absent.py")
     assert run.returncode == 4 and "scene source 'absent.py'" in run.stderr
+
+
+def test_a_printed_command_names_the_scene_file_even_when_populate_lives_in_a_helper(tmp_path):
+    """Printed commands give --scenes the source that registered the scene: a scene file that imports its
+    populate from a helper module is named, not the helper (which defines no SceneSpec)."""
+    text = _example()
+    helper, _, rest = text.partition("\ndef parameters():")
+    (tmp_path / "die_helpers.py").write_text(helper, encoding="utf-8")
+    (tmp_path / "my_scenes.py").write_text("from conformance.scenes import Camera, SceneSpec, Shape\n"
+                                           "from die_helpers import populate\n\n\ndef parameters():" + rest,
+                                           encoding="utf-8")
+    probe = ("from conformance import own_scenes\n"
+             "own_scenes.load('my_scenes.py')\n"
+             "print(own_scenes.scene_arguments('tossed_die'))\n")
+    done = subprocess.run([sys.executable, "-c", probe], cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.strip().splitlines()[-1] == "['--scenes', 'my_scenes.py']", done.stdout
