@@ -84,7 +84,7 @@ def test_an_impostor_sphere_is_placed_as_the_sphere_it_draws():
 def test_a_note_names_the_ranges_a_frame_holds_not_one_range_over_them():
     """A frame holding vertices 0-2 and 40-63 of an actor is told as ``0:3, 40:64``: ``0:64`` claimed the
     vertices between, held by another frame (notes named overlapping ranges of one actor)."""
-    from conformance.apps.judge import _ranges
+    from conformance.apps.recording import vertex_ranges as _ranges
 
     assert _ranges(np.array([0, 1, 2, 40, 41, 42])) == "0:3, 40:43"
     assert _ranges(np.arange(24)) == "0:24"

@@ -24,9 +24,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from conformance.apps import attachment as attach_mod, welds
+from conformance.apps import attachment as attach_mod, soft_bodies, welds
 from conformance.apps.placement import bounding_radius, bounding_sphere, distance_to_shapes, place
-from conformance.apps.recording import Recording
+from conformance.apps.recording import Recording, vertex_ranges
 from conformance.tolerances import DEFAULT, Tolerance
 
 __all__ = ["CHECKS", "DIAGNOSES", "Verdict", "judge"]
@@ -193,7 +193,7 @@ class _Judgement:
                 info = self.r.frames[frame] if frame >= 0 else None
                 if info is not None and info.node >= 0:
                     soft.setdefault((info.client, info.body, info.name, diagnosis), []).append(
-                        (rows, error[:, first].max(), first, error[:, k].max(), k, allowance.max()))
+                        soft_bodies.Piece(rows, error[:, first].max(), first, error[:, k].max(), k, allowance.max()))
                     continue
                 verdict.lines.append(
                     f"{track.label} ({track.kind}) vertices {start}:{stop} of {len(a.frame)}: not held by any frame; "
@@ -201,16 +201,7 @@ class _Judgement:
                     f"{error[:, first].max():.3g} m from where that frame carries it (allowed "
                     f"{allowance.max():.3g} m); worst {error[:, k].max():.3g} m at tick {k + 1}")
                 verdict.diagnosed(diagnosis)
-            for (client, body, name, diagnosis), pieces in soft.items():
-                rows = np.concatenate([piece[0] for piece in pieces])
-                first = min(pieces, key=lambda piece: piece[2])
-                farthest = max(pieces, key=lambda piece: piece[3])
-                verdict.lines.append(
-                    f"{track.label} ({track.kind}) vertices {_ranges(rows)} of {len(a.frame)}: not held by any frame; "
-                    f"each follows a node of {'client %d ' % client if client else ''}soft body {body} ({name}) best, "
-                    f"and the first left it at tick {first[2] + 1}: {first[1]:.3g} m from that node (allowed "
-                    f"{max(piece[5] for piece in pieces):.3g} m); worst {farthest[3]:.3g} m at tick {farthest[4] + 1}")
-                verdict.diagnosed(diagnosis)
+            soft_bodies.attached(track, a, soft, verdict)
         for entry in self.r.mapping:
             self._judge_mapped(entry, verdict)
         welded = sum(int(a.welded.sum()) for a in self.attachments if a.welded is not None)
@@ -370,7 +361,7 @@ class _Judgement:
         followed = set(self.followed_badly)  # loose vertices that follow a frame are the attached check's
         for a in self.attachments:
             followed.update(int(f) for f in np.unique(a.frame[a.held]) if f >= 0)
-        self._soft_drawn(verdict, followed)
+        soft_bodies.drawn(self, verdict, followed)
         for index, frame in enumerate(self.r.frames):
             if index in followed or not frame.shapes:
                 continue
@@ -386,55 +377,6 @@ class _Judgement:
             if near:
                 verdict.diagnosed("never-moved")
         return verdict
-
-    def _soft_drawn(self, verdict: Verdict, followed: set) -> None:
-        """A soft body is drawn when every node of it that moves is followed by some drawn vertex: a program
-        that copies all but the last node, or none, leaves nodes moving with nothing drawn on them."""
-        for (client, body), nodes in self._soft_bodies().items():
-            allowance = 10 * self.tolerance.for_extents(np.zeros(len(nodes)), self.pos[0, nodes])
-            moved = np.array([self._movement(i, 0.0) for i in nodes])
-            missing = [i for i, m, a in zip(nodes, moved, allowance) if m > a and i not in followed]
-            if not missing:
-                continue
-            verdict.passed = False
-            frame = self.r.frames[nodes[0]]
-            numbers = [self.r.frames[i].node for i in missing]
-            shown = ", ".join(map(str, numbers[:8])) + (f" … ({len(numbers)} of {len(nodes)})" if len(numbers) > 8 else "")
-            left = self._left_at_nodes(missing)
-            verdict.lines.append(f"{'client %d ' % client if client else ''}soft body {body} ({frame.name}): "
-                                 f"node{'s' if len(numbers) > 1 else ''} {shown} move (up to "
-                                 f"{max(moved[nodes.index(i)] for i in missing):.3g} m over ticks 1..{self.r.ticks}) but no "
-                                 "drawn vertex follows them: copy every node of getMeshData(body, -1, "
-                                 "flags=p.MESH_DATA_SIMULATION_MESH) into the actor after each step"
-                                 + (f"; {left} stay where they were built, on those nodes" if left else ""))
-            if left:
-                verdict.diagnosed("never-moved")
-
-    def _left_at_nodes(self, nodes: list[int]) -> str:
-        """The actor ranges held by the world that were drawn, when the loop started, on ``nodes`` (frame
-        indices): a soft body drawn once and never copied again."""
-        from scipy.spatial import cKDTree
-
-        tree = cKDTree(self.r.positions[0, nodes])
-        found = []
-        for track, a in zip(self.r.actors, self.attachments):
-            world = np.flatnonzero((a.frame < 0) & a.held)
-            if not len(world):
-                continue
-            distance, _ = tree.query(track.vertices[0, world])
-            allowed = 10 * self.tolerance.for_extents(np.zeros(len(world)), track.vertices[0, world])
-            on = world[distance <= allowed]
-            if len(on):
-                found.append(f"{track.label} vertices {_ranges(on)}")
-        return ", ".join(found)
-
-    def _soft_bodies(self) -> dict[tuple[int, int], list[int]]:
-        """The node frames of each soft body, by (client, body)."""
-        found: dict[tuple[int, int], list[int]] = {}
-        for index, frame in enumerate(self.r.frames):
-            if frame.node >= 0:
-                found.setdefault((frame.client, frame.body), []).append(index)
-        return found
 
     def _movement(self, index: int, radius: float) -> float:
         if self.r.ticks == 0:
@@ -499,9 +441,9 @@ class _Judgement:
             info = self.r.frames[frame]
             if info.node >= 0:
                 soft.setdefault((track.label, info.client, info.body, info.name), []).append(
-                    (rows, frame, self._off_node(a.reference[rows], frame)))
+                    (rows, frame, soft_bodies.off_node(self, a.reference[rows], frame)))
                 continue
-            where = f"{track.label} vertices {_ranges(rows)} held by {info.label}"
+            where = f"{track.label} vertices {vertex_ranges(rows)} held by {info.label}"
             if not result.judged:
                 verdict.notes.append(f"{where}: {result.why}")
             elif not result.ok:
@@ -509,31 +451,8 @@ class _Judgement:
                 diagnosis = result.diagnosis or self._other_body(result.offset, frame)
                 verdict.lines.append(f"{where}: {result.why}")
                 verdict.diagnosed(diagnosis)
-        for (label, client, body, name), pieces in soft.items():
-            rows = np.sort(np.concatenate([piece[0] for piece in pieces]))
-            soft_body = f"{'client %d ' % client if client else ''}soft body {body} ({name})"
-            off = [piece for piece in pieces if piece[2][0] > piece[2][1]]
-            if not off:
-                verdict.notes.append(f"{label} vertices {_ranges(rows)} follow nodes of {soft_body}, each drawn at its node")
-                continue
-            verdict.passed = False
-            worst = max(off, key=lambda piece: piece[2][0] / max(piece[2][1], 1e-300))
-            off_rows = np.sort(np.concatenate([piece[0] for piece in off]))
-            verdict.lines.append(
-                f"{label} vertices {_ranges(off_rows)} ({len(off_rows)} of the {len(rows)} that follow nodes of "
-                f"{soft_body}) are not drawn at the node they follow: vertices {_ranges(worst[0])} follow node "
-                f"{self.r.frames[worst[1]].node} {worst[2][0]:.3g} m away from it (allowed {worst[2][1]:.3g} m)")
-            verdict.diagnosed("node-order")
+        soft_bodies.placed(self, soft, verdict)
         return verdict
-
-    def _off_node(self, offsets: np.ndarray, frame: int) -> tuple[float, float]:
-        """How far the centre of the vertices a node holds lies from the node, and what is allowed: a drawing
-        that follows a node is drawn at it (a vertex on it, or a small sphere around it), as the rigid
-        checks ask a drawing's centre to be its shape's."""
-        centre = offsets.mean(axis=0)
-        spread = float(np.max(np.linalg.norm(offsets - centre, axis=1), initial=0.0))
-        allowed = 10 * self.tolerance.for_extents(np.array([spread]), self.pos[:1, frame])[0]
-        return float(np.linalg.norm(centre)), float(allowed)
 
     def _inertial(self, frame: int) -> np.ndarray:
         return np.asarray(self.r.frames[frame].inertial, dtype=np.float64)
@@ -622,20 +541,6 @@ class _Judgement:
             verdict.diagnosed("written-back")
         verdict.worst = float(change.max())
         return verdict
-
-
-def _ranges(rows: np.ndarray, most: int = 3) -> str:
-    """Sorted vertex indices as the ranges they make: ``0:24``, ``0:3, 40:64``, ``0:3, 8:9, 12:20 and 4
-    more ranges`` (a frame may hold scattered vertices of an actor; one range over them would claim the
-    vertices between)."""
-    rows = np.asarray(rows)
-    if not len(rows):
-        return "none"
-    breaks = np.flatnonzero(np.diff(rows) != 1) + 1
-    starts, stops = np.concatenate([[0], breaks]), np.concatenate([breaks, [len(rows)]])
-    spans = [f"{rows[a]}:{rows[b - 1] + 1}" for a, b in zip(starts, stops)]
-    more = len(spans) - most
-    return ", ".join(spans[:most]) + (f" and {more} more range{'s' if more > 1 else ''}" if more > 0 else "")
 
 
 def _drawn_points(reference: np.ndarray, radii: np.ndarray | None, rows: np.ndarray) -> np.ndarray:

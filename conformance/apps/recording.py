@@ -18,7 +18,7 @@ import numpy as np
 from conformance.apps.bodies import Frame
 from conformance.files import write_atomically
 
-__all__ = ["ActorTrack", "Recording", "load", "save"]
+__all__ = ["ActorTrack", "Recording", "load", "save", "vertex_ranges"]
 
 
 @dataclass
@@ -150,3 +150,17 @@ def load(path) -> Recording:
                          meta["events"], meta["notes"], meta.get("error", ""),
                          meta.get("seconds", {}), data["writes"] if "writes" in data else None,
                          meta.get("writers", []), mapping=meta.get("mapping", []), pictures=pictures)
+
+
+def vertex_ranges(rows: np.ndarray, most: int = 3) -> str:
+    """Sorted vertex indices as the ranges they make: ``0:24``, ``0:3, 40:64``, ``0:3, 8:9, 12:20 and 4
+    more ranges`` (a frame may hold scattered vertices of an actor; one range over them would claim the
+    vertices between)."""
+    rows = np.asarray(rows)
+    if not len(rows):
+        return "none"
+    breaks = np.flatnonzero(np.diff(rows) != 1) + 1
+    starts, stops = np.concatenate([[0], breaks]), np.concatenate([breaks, [len(rows)]])
+    spans = [f"{rows[a]}:{rows[b - 1] + 1}" for a, b in zip(starts, stops)]
+    more = len(spans) - most
+    return ", ".join(spans[:most]) + (f" and {more} more range{'s' if more > 1 else ''}" if more > 0 else "")
