@@ -28,8 +28,9 @@ def tolerance_of(args):
     from conformance import validation
     from conformance.tolerances import DEFAULT
 
-    given = {name: validation.finite_non_negative(f"--conformance-{name.replace('_', '-')}", getattr(args, name))
-             for name in TOLERANCES if getattr(args, name) is not None}
+    values = {name: getattr(args, name, None) for name in TOLERANCES}  # a namespace made in code may lack them
+    given = {name: validation.finite_non_negative(f"--conformance-{name.replace('_', '-')}", value)
+             for name, value in values.items() if value is not None}
     return dataclasses.replace(DEFAULT, **given)
 
 
