@@ -113,14 +113,16 @@ def load(source: str, *, relative_to: Path | str | None = None) -> list[str]:
                           "give it one at module level, e.g. SPEC = SceneSpec(name='my_scene', …)")
     # What loaded them, as it can be given again: the file for a path, the module's name for a module (a
     # package's module re-imported as a file would lose its relative imports).
-    given = str(Path(module.__file__).resolve()) if _is_path(source) and getattr(module, "__file__", None) else source
+    file = str(Path(module.__file__).resolve()) if getattr(module, "__file__", None) else None
+    given = file if _is_path(source) and file else source
     for name in names:
-        _LOADED_FROM.setdefault(name, given)
+        _LOADED_FROM.setdefault(name, (given, file))
     return names
 
 
-#: Each own scene's source, as it was loaded (``load``): what a printed command gives ``--scenes``.
-_LOADED_FROM: dict[str, str] = {}
+#: Each own scene's source as it was loaded (``load``): what a printed command gives ``--scenes``, and
+#: the file it is (beside which the scene's goldens live).
+_LOADED_FROM: dict[str, tuple[str, str | None]] = {}
 
 
 def _module_of(spec) -> str | None:
@@ -162,10 +164,14 @@ def source_of(name: str) -> str | None:
     ini or ``$CONFORMANCE_SCENES``), else the file that defines its ``populate``; None for the kit's own
     scenes. Not ``populate``'s file first: a scene file may import its ``populate`` from a helper module,
     which defines no SceneSpec."""
+    if name in _LOADED_FROM:
+        return _LOADED_FROM[name][0]
+    return _populate_file(name)
+
+
+def _populate_file(name: str) -> str | None:
     from conformance import scenes
 
-    if name in _LOADED_FROM:
-        return _LOADED_FROM[name]
     populate = scenes.get(name).populate
     if (getattr(populate, "__module__", "") or "").startswith(scenes.__name__ + "."):
         return None  # the kit's (in a checkout and in a wheel alike: the package conformance.scenes)
@@ -195,7 +201,7 @@ def golden_dir(name: str) -> Path:
     from conformance import backends
     from conformance.rendering import golden
 
-    source = source_of(name)
-    if source is None:
+    if source_of(name) is None:
         return golden.default_dir()
-    return Path(source).parent / "golden" / backends.NAME
+    file = _LOADED_FROM[name][1] if name in _LOADED_FROM else None
+    return Path(file or _populate_file(name) or ".").parent / "golden" / backends.NAME

@@ -224,3 +224,23 @@ def test_a_printed_command_names_the_scene_file_even_when_populate_lives_in_a_he
     done = subprocess.run([sys.executable, "-c", probe], cwd=tmp_path, capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr[-2000:]
     assert done.stdout.strip().splitlines()[-1] == "['--scenes', 'my_scenes.py']", done.stdout
+
+
+def test_a_scene_from_a_module_is_named_by_the_module_and_its_goldens_sit_beside_its_file(tmp_path):
+    """A scene source given as a module's name is printed as that name (re-imported as a file, a package's
+    module would lose its relative imports), and its goldens live beside the module's file."""
+    package = tmp_path / "mypkg"
+    package.mkdir()
+    (package / "__init__.py").write_text("")
+    (package / "scenes.py").write_text(_example(), encoding="utf-8")
+    probe = ("from conformance import own_scenes\n"
+             "own_scenes.load('mypkg.scenes')\n"
+             "print(own_scenes.scene_arguments('tossed_die'))\n"
+             "print(own_scenes.golden_dir('tossed_die').relative_to(__import__('os').getcwd()))\n")
+    env = {**os.environ, "PYTHONPATH": str(tmp_path)}
+    done = subprocess.run([sys.executable, "-c", probe], cwd=tmp_path, env=env, capture_output=True, text=True,
+                          timeout=300)
+    assert done.returncode == 0, done.stderr[-2000:]
+    arguments, goldens = done.stdout.strip().splitlines()[-2:]
+    assert arguments == "['--scenes', 'mypkg.scenes']", done.stdout
+    assert goldens == f"mypkg/golden/{backends.NAME}", done.stdout
