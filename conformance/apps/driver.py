@@ -215,13 +215,13 @@ class Driver:
             self.error = (f"the app raised at tick {self._tick}: {type(exc).__name__}: {exc}\n"
                           + "".join(traceback.format_exception(exc)[-6:]))
 
-    @_kit_code("recording the state before the app's write")
     def faulted(self, fault: BaseException) -> None:
         """A :class:`KitFault` went through a window loop that swallows what its callbacks raise (VTK's
         observers): keep the first, for the loop to raise once the tick is over."""
         if isinstance(fault, KitFault) and self.fault is None:
             self.fault = fault
 
+    @_kit_code("recording the state before the app's write")
     def before_write(self, name: str) -> None:
         """The app is about to write to pyBullet's state: after this tick's last step that is the sync's part
         of the tick, which should only read. The state before the first such write is kept to compare."""
