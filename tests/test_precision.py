@@ -101,6 +101,22 @@ def test_precision_reports_a_wrong_sync_as_a_false_alarm_with_its_replay_line(tm
     assert again.returncode == 1 and "failed" in again.stdout, again.stdout[-2000:]
 
 
+def test_checks_gives_only_the_checks_it_picks_their_runs(tmp_path):
+    """``--checks EXPR`` runs only what ``pytest -k EXPR`` picks of the drawing checks (how the checks that
+    draw their own scene get thousands of runs cheaply), says so in the table, and keeps it in the made-by line."""
+    out = tmp_path / "precision.md"
+    done = subprocess.run([sys.executable, "-m", "conformance", "precision", "--seeds", "2", "--factor", "3",
+                           "--checks", "test_engine_defaults or test_friction_of_one_body_alone", "--out", str(out)],
+                          capture_output=True, text=True, timeout=900)
+    assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
+    text = out.read_text()
+    rows = [line.split("`")[1] for line in text.splitlines() if line.startswith("| `")]
+    assert rows == ["test_engine_defaults", "test_friction_of_one_body_alone_does_nothing"], text
+    assert "| `test_engine_defaults` | 6 | 0 |" in text, text
+    assert "only the checks `-k test_engine_defaults or test_friction_of_one_body_alone` picks" in text, text
+    assert "--checks 'test_engine_defaults or test_friction_of_one_body_alone'" in text, text
+
+
 def test_a_journal_keeps_each_draw_and_a_run_goes_on_where_it_stopped(tmp_path, monkeypatch):
     """Each draw is appended as it finishes; a line cut short by a kill is made again, every other draw is
     not (``precision --journal``)."""

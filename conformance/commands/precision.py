@@ -30,6 +30,10 @@ def add_arguments(parser) -> None:
     parser.add_argument("--factor", type=argparse_type(positive_int, "--factor", high=100_000), default=10,
                         help="default-profile runs of each check one process stands for (its examples are this "
                         "multiple of the default's; default 10)")
+    parser.add_argument("--checks", default="", metavar="EXPR",
+                        help="only the drawing checks pytest's -k EXPR picks: to give the checks that draw their own "
+                        "scene (the physics laws) many more runs at a small cost, e.g. --checks 'not test_vertices_match "
+                        "and not test_syncing_every and not test_builds_across and not test_sync_order'")
     parser.add_argument("--app-runs", type=argparse_type(whole_number, "--app-runs", high=1000), default=3, metavar="K",
                         help="perturbed runs of each app per seed (default 3)")
     parser.add_argument("--jobs", type=jobs, default=None, help="processes at a time (default 1)")
@@ -66,8 +70,9 @@ def run(args, extra) -> int:
     # The few draws first, the named syncs' many last: a long run stopped part-way has some of everything,
     # and with --journal a second run with fewer --seeds tabulates what the first made.
     app_runs = precision.app_draws(paths, seeds(args.app_seeds), runs=args.app_runs, **common) if paths else []
-    syncs = precision.sync_draws(others, seeds(args.right_seeds), factor=args.factor, **common)
-    syncs = precision.sync_draws(named, seeds(args.seeds), factor=args.factor, **common) + syncs
+    drawn = {"factor": args.factor, "select": args.checks}
+    syncs = precision.sync_draws(others, seeds(args.right_seeds), **drawn, **common)
+    syncs = precision.sync_draws(named, seeds(args.seeds), **drawn, **common) + syncs
     made_by = shlex.join(["python", "-m", "conformance", "precision", *args.specs,
                           *[part for module in args.right for part in ("--right", module)],
                           *[part for pattern in args.apps for part in ("--apps", pattern)],
@@ -75,6 +80,7 @@ def run(args, extra) -> int:
                           "--seeds", str(args.seeds), *(["--right-seeds", str(args.right_seeds)] if args.right_seeds else []),
                           *(["--app-seeds", str(args.app_seeds)] if args.app_seeds else []),
                           "--first-seed", str(args.first_seed), "--factor", str(args.factor),
+                          *(["--checks", args.checks] if args.checks else []),
                           *(["--app-runs", str(args.app_runs)] if paths else [])])
     emit(precision.markdown(syncs, app_runs, made_by=made_by, backend=backends.describe()), args.out)
     alarms = any(d.false_alarms or d.broken for d in syncs) or any(d.failed or d.error for d in app_runs)
