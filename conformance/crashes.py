@@ -6,7 +6,7 @@ and the process that started pytest survives to give the verdict. What is guaran
 
 * **Isolation** (``--conformance-isolation`` / ini ``conformance_isolation``): ``auto``, the default, runs
   a serial run in one worker process when the sync under test is not one of the kit's own (the short
-  names of :data:`conformance.sync.SHORT_NAMES`, which are tested here and do not crash); ``process``
+  names of :data:`conformance.implementations.SHORT_NAMES`, which are tested here and do not crash); ``process``
   does so for any sync; ``none`` runs in pytest's own process, where a crash ends the run as it would
   without the kit. A run given ``-n`` is already in workers. It is not isolated under ``--pdb`` or
   ``--trace`` (a debugger needs the test in the terminal's process), nor without pytest-xdist.
@@ -42,10 +42,9 @@ import pytest
 
 from conformance.errors import SyncCrashed
 
-__all__ = ["CHOICES", "Controller", "Journal", "Watchdog", "allow_restarts", "arrange", "at", "check_not_crashed",
+__all__ = ["Controller", "Journal", "Watchdog", "allow_restarts", "arrange", "at", "check_not_crashed",
            "hard_limit", "noting", "returned", "start_journal"]
 
-CHOICES = ("auto", "process", "none")
 _INPUT_KEY = "conformance_crash_dir"
 #: Restarts allowed beyond xdist's own (four per worker): one crash per scene at most (see above).
 _RESTARTS_PER_SCENE = 1
@@ -57,7 +56,7 @@ _journal: "Journal | None" = None
 def arrange(config, sync_spec: str, mode: str) -> bool:
     """Before pytest-xdist reads its options (``pytest_cmdline_main``): ask for one worker when the run
     is serial and ``mode`` says to isolate it. Returns whether the run will be in workers."""
-    from conformance.sync import SHORT_NAMES
+    from conformance.implementations import SHORT_NAMES
 
     if hasattr(config, "workerinput") or not config.pluginmanager.hasplugin("xdist"):
         return False

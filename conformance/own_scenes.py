@@ -34,7 +34,7 @@ from typing import Iterable
 
 from conformance.errors import BadArgument
 
-__all__ = ["ENTRY_POINTS", "ENV", "golden_dir", "load", "load_all", "scene_arguments", "source_of", "sources_from"]
+__all__ = ["ENTRY_POINTS", "ENV", "default_dir", "golden_dir", "load", "load_all", "scene_arguments", "source_of", "sources_from"]
 
 ENV = "CONFORMANCE_SCENES"
 ENTRY_POINTS = "conformance.scenes"
@@ -195,13 +195,20 @@ def scene_arguments(name: str) -> list[str]:
     return ["--scenes", source]
 
 
+def default_dir() -> Path:
+    """The goldens shipped with the kit for the backend in force: ``golden/<backend>/`` in a checkout,
+    ``conformance/golden/<backend>/`` in a wheel (renderers differ, so each backend has its own)."""
+    from conformance import backends
+
+    return Path(__file__).resolve().parent / "golden" / backends.NAME
+
+
 def golden_dir(name: str) -> Path:
     """Where scene ``name``'s goldens live when no golden directory is given: the kit's own for its
     scenes, ``golden/<backend>/`` beside the user's file for theirs."""
     from conformance import backends
-    from conformance.rendering import golden
 
     if source_of(name) is None:
-        return golden.default_dir()
+        return default_dir()
     file = _LOADED_FROM[name][1] if name in _LOADED_FROM else None
     return Path(file or _populate_file(name) or ".").parent / "golden" / backends.NAME

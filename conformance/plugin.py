@@ -130,10 +130,10 @@ def tolerance_from(config: pytest.Config):
 
 def _sync_spec(config: pytest.Config) -> str:
     from conformance.errors import BadArgument
-    from conformance.sync import resolve_spec
+    from conformance.validation import resolve_sync
 
     try:  # an empty --sync, ini value or $CONFORMANCE_SYNC is refused, never read as "the default"
-        return resolve_spec(config.getoption("conformance_sync"), config.getini("conformance_sync"))
+        return resolve_sync(config.getoption("conformance_sync"), config.getini("conformance_sync"))
     except BadArgument as err:
         raise pytest.UsageError(str(err)) from None
 
@@ -250,7 +250,7 @@ def _watch_for_crashes(config: pytest.Config) -> None:
     seconds = _option(config, "sync_timeout")  # a bad value: the usage error, here, once
     tolerance_from(config)
     config.pluginmanager.register(crashes.Controller(config, spec, _RECORD_PROPERTY, seconds), "conformance-crashes")
-    from conformance.sync import SHORT_NAMES
+    from conformance.implementations import SHORT_NAMES
 
     if spec not in SHORT_NAMES:
         from conformance.errors import SyncError

@@ -11,10 +11,13 @@ its path relative to the current directory and its absolute path (``.venv/bin/py
 
 from __future__ import annotations
 
+import json
 import os
+import shlex
 import sys
+from typing import Any, Mapping, Sequence
 
-__all__ = ["KIT_ENV", "pytest", "python"]
+__all__ = ["KIT_ENV", "pytest", "python", "reproduce_command", "rerun_check", "tolerance_arguments"]
 
 #: set by ``./kit`` for every command it runs: the backend it chose
 KIT_ENV = "CONFORMANCE_KIT_BACKEND"
@@ -36,3 +39,38 @@ def python() -> str:
 def pytest() -> list[str]:
     """The words that start a printed pytest command."""
     return ["pytest"] if python() == "python" else [python(), "-m", "pytest"]
+
+
+def tolerance_arguments(tolerance) -> list[str]:
+    """The ``--conformance-…`` options that give ``tolerance`` where it is not the kit's default."""
+    from conformance.tolerances import DEFAULT
+
+    fields = ("size_rtol", "position_rtol", "atol", "normal_angle")
+    return [w for name in fields if tolerance is not None and getattr(tolerance, name) != getattr(DEFAULT, name)
+            for w in (f"--conformance-{name.replace('_', '-')}", repr(getattr(tolerance, name)))]
+
+
+def rerun_check(check_id: str, scene: str, sync: str, tolerance=None, given: Sequence[str] = ()) -> str:
+    """The pytest command that runs the check ``check_id`` (its whole id: ``test_x[scene]``) again, with the
+    scene's source for a user's scene, the tolerance of this run, and the options ``given``."""
+    from conformance import own_scenes
+
+    return shlex.join([*pytest(), "--pyargs", "conformance", "-k", check_id, "--sync", sync,
+                       *own_scenes.scene_arguments(scene), *tolerance_arguments(tolerance), *given])
+
+
+def reproduce_command(scene: str, sync: str, frames: int, params: Mapping[str, Any], events: Sequence = (),
+                      tolerance=None) -> str:
+    """The command line that replays a run frame by frame and prints every target's error (the vertex
+    checks': vertices, normals and announcements), to ``tolerance`` when it is not the kit's."""
+    from conformance import own_scenes
+
+    words = [python(), "-m", "conformance", "check", scene, *own_scenes.scene_arguments(scene), "--sync", sync,
+             "--frames", str(frames), *tolerance_arguments(tolerance)]
+    if params:
+        words += ["--params", json.dumps(dict(params), sort_keys=True)]
+    if events:
+        from conformance import events as events_module
+
+        words += ["--events", events_module.dumps(events)]
+    return shlex.join(words)

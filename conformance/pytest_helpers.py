@@ -13,8 +13,6 @@ from __future__ import annotations
 
 import contextlib
 import functools
-import json
-import shlex
 import weakref
 from typing import Any, Callable, Iterable, Iterator, Mapping, Sequence
 
@@ -23,6 +21,7 @@ import pytest
 from conformance import compare, diagnosis, events as events_module, figures, profiles, scenes, survey as survey_module
 from conformance.errors import SyncError
 from conformance.survey import WORST  # noqa: F401  (where the plugin and older callers find it)
+from conformance.printed import reproduce_command
 from conformance.tolerances import Tolerance
 
 #: The label of the vertex checks' ``hypothesis.target``: the worst vertex error over its tolerance.
@@ -36,7 +35,6 @@ __all__ = [
     "bounds_figure",
     "each_golden_variant",
     "each_scene",
-    "reproduce_command",
     "sync_run",
 ]
 
@@ -63,39 +61,6 @@ def each_golden_variant(argnames: str = "scene_name, variant"):
         params += [pytest.param(name, dict(v), id=f"{name}-{variant_id(v)}", marks=pytest.mark.scene(name))
                    for v in scenes.get(name).golden_variants]
     return pytest.mark.parametrize(argnames, params)
-
-
-def tolerance_arguments(tolerance) -> list[str]:
-    """The ``--conformance-…`` options that give ``tolerance`` where it is not the kit's default."""
-    from conformance.tolerances import DEFAULT
-
-    fields = ("size_rtol", "position_rtol", "atol", "normal_angle")
-    return [w for name in fields if tolerance is not None and getattr(tolerance, name) != getattr(DEFAULT, name)
-            for w in (f"--conformance-{name.replace('_', '-')}", repr(getattr(tolerance, name)))]
-
-
-def rerun_check(check_id: str, scene: str, sync: str, tolerance=None, given: Sequence[str] = ()) -> str:
-    """The pytest command that runs the check ``check_id`` (its whole id: ``test_x[scene]``) again, with the
-    scene's source for a user's scene, the tolerance of this run, and the options ``given``."""
-    from conformance import own_scenes, printed
-
-    return shlex.join([*printed.pytest(), "--pyargs", "conformance", "-k", check_id, "--sync", sync,
-                       *own_scenes.scene_arguments(scene), *tolerance_arguments(tolerance), *given])
-
-
-def reproduce_command(scene: str, sync: str, frames: int, params: Mapping[str, Any], events: Sequence = (),
-                      tolerance=None) -> str:
-    """The command line that replays a run frame by frame and prints every target's error (the vertex
-    checks': vertices, normals and announcements), to ``tolerance`` when it is not the kit's."""
-    from conformance import own_scenes, printed
-
-    words = [printed.python(), "-m", "conformance", "check", scene, *own_scenes.scene_arguments(scene), "--sync", sync,
-             "--frames", str(frames), *tolerance_arguments(tolerance)]
-    if params:
-        words += ["--params", json.dumps(dict(params), sort_keys=True)]
-    if events:
-        words += ["--events", events_module.dumps(events)]
-    return shlex.join(words)
 
 
 def _label(scene: str, params: Mapping[str, Any]) -> str:

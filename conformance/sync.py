@@ -29,32 +29,15 @@ from typing import Any, Callable
 from conformance import crashes
 from conformance import time_limit as limits
 from conformance.errors import SyncLoadError, SyncProtocolError, SyncRaised, SyncTimedOut
+from conformance.implementations import SHORT_NAMES
+from conformance.validation import SYNC_ENV_VAR
 from conformance.world import World
 
-__all__ = ["ENV_VAR", "SHORT_NAMES", "Syncer", "SyncImplementation", "load", "resolve_spec"]
+__all__ = ["ENV_VAR", "SHORT_NAMES", "Syncer", "SyncImplementation", "load"]
 
-ENV_VAR = "CONFORMANCE_SYNC"
+ENV_VAR = SYNC_ENV_VAR
 _IMPORTLIB = os.path.dirname(importlib.__file__)
-DEFAULT = "reference"
 
-#: Implementations shipped with the kit, selectable by these names.
-SHORT_NAMES = {
-    "reference": "conformance.implementations.reference:ReferenceSync",
-    "guide": "conformance.implementations.guide:GuideSync",
-    "guide-actor": "conformance.implementations.guide:GuideActorSync",
-    "guide-vertex": "conformance.implementations.guide:GuideVertexSync",
-    "guide-joint": "conformance.implementations.guide:GuideJointSync",
-}
-
-
-def resolve_spec(option: str | None, ini: str | None = None) -> str:
-    """The spec in force: the ``--sync`` option, else the ini ``conformance_sync``, else
-    ``$CONFORMANCE_SYNC``, else ``reference``. ``None`` is "not given"; a value given empty, the
-    variable set to nothing included, raises :class:`~conformance.errors.BadArgument` rather than
-    quietly running the default (see :func:`conformance.validation.resolve_sync`)."""
-    from conformance.validation import resolve_sync
-
-    return resolve_sync(option, ini)
 
 
 def _exception_line(exc: BaseException) -> str:
@@ -185,7 +168,7 @@ def load(spec: str) -> SyncImplementation:
             dotted = module_name.removesuffix(".py").replace(os.sep, ".").replace("/", ".").strip(".")
             relative = not os.path.isabs(module_name)
             top = module_name.replace(os.sep, "/").split("/")[0] if relative else ""
-            hint = (f" --sync takes a module's dotted name, not a file's path: "
+            hint = (" --sync takes a module's dotted name, not a file's path: "
                     + (f"'{dotted}:{attribute}', run from the directory that holds {top!r}." if relative else
                        f"'{Path(module_name).stem}:{attribute}' with {str(Path(module_name).parent)!r} on PYTHONPATH "
                        "(or run from there)."))

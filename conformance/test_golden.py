@@ -40,7 +40,7 @@ def _reproduce(check: str, scene: str, sync: str, variant: dict | None = None, p
     verdict: the user's scenes, and the golden directory and image tolerance given."""
     import os
 
-    from conformance.pytest_helpers import rerun_check
+    from conformance.printed import rerun_check
 
     # The whole id, brackets included: "mixed_shapes" alone would select its variants' checks too.
     selected = f"{check}[{scene}-{variant_id(variant)}]" if variant else f"{check}[{scene}]"
@@ -93,7 +93,7 @@ def test_golden_render(scene_name, variant, kit, pictures, request):
         record, images = reftest.judge(golden, drawn[frame], references[frame], here=pictures.renderer,
                                        override=pictures.override, sync=kit.sync)
         if "difference" in images and not blamed:  # the sync's verdict failed: name the bodies, once
-            from conformance.pytest_helpers import reproduce_command
+            from conformance.printed import reproduce_command
 
             blamed = [f"{reftest.bodies_where_pixels_differ(scene_name, golden, variant, references[frame], drawn[frame])}"
                       f" [{scene_name}, frame {frame}]; the vertices, frame by frame (a mistake there is named): "

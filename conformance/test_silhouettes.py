@@ -15,7 +15,8 @@ from hypothesis import given, strategies as st
 from conformance import backends, image_options, scenes, shared_run, strategies
 from conformance.events import Teleport
 from conformance.profiles import check_settings
-from conformance.pytest_helpers import _context, each_scene, reproduce_command, rerun_check
+from conformance.printed import reproduce_command, rerun_check
+from conformance.pytest_helpers import _context, each_scene
 from conformance.rendering import framing, golden, silhouettes
 
 def silhouette_check(run, sync: str, pictures=None, nodeid: str = "", check: str = "test_silhouettes_match_in_any_orientation",

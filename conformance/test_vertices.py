@@ -16,7 +16,8 @@ from hypothesis import example, given, strategies as st
 from conformance import backends, compare, figures, profiles, scenes, shared_run, strategies
 from conformance.events import turning_everything
 from conformance.profiles import check_settings
-from conformance.pytest_helpers import _context, bounds_figure, each_scene, rerun_check
+from conformance.printed import rerun_check
+from conformance.pytest_helpers import _context, bounds_figure, each_scene
 
 
 def _scene_runs(scene_name: str, longest: int):

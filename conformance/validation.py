@@ -27,17 +27,18 @@ from pathlib import Path
 from typing import Any, Mapping, Sequence
 
 from conformance.errors import BadArgument
+from conformance.implementations import SHORT_NAMES
 
 __all__ = [
     "DEFAULT_RESULTS",
     "DEFAULT_SYNC",
     "IMAGE_TOLERANCE_CHOICES",
+    "ISOLATION_CHOICES",
     "MAX_ANIMATION_FRAMES",
     "MAX_ANIMATION_PIXELS",
     "MAX_IMAGE_SIDE",
     "MAX_JOBS",
     "MAX_STEPS",
-    "SHORT_SYNC_NAMES",
     "SYNC_ENV_VAR",
     "TOLERANCE_OPTIONS",
     "PluginOptions",
@@ -75,10 +76,11 @@ MAX_ANIMATION_PIXELS = 100_000_000
 #: pytest processes at a time for ``verdicts`` and ``kill-rate``.
 MAX_JOBS = 256
 
-SYNC_ENV_VAR = "CONFORMANCE_SYNC"  # the same as conformance.sync.ENV_VAR, without importing pybullet
+#: The environment variable that names the sync when neither --sync nor the ini does (``conformance.sync.ENV_VAR``).
+SYNC_ENV_VAR = "CONFORMANCE_SYNC"
 DEFAULT_SYNC = "reference"
-#: conformance.sync.SHORT_NAMES, named here without importing pybullet (a test keeps the two equal).
-SHORT_SYNC_NAMES = ("reference", "guide", "guide-actor", "guide-vertex", "guide-joint")
+#: ``--conformance-isolation``: a serial run in a worker process of its own (``conformance.crashes``).
+ISOLATION_CHOICES = ("auto", "process", "none")
 
 IMAGE_TOLERANCE_CHOICES = ("auto", "same-renderer", "other-renderer")
 
@@ -199,7 +201,7 @@ def choice(name: str, value: Any, choices: Sequence[str]) -> str:
 def sync_spec(name: str, value: Any, *, default_hint: str = "") -> str:
     """A sync spec as given: a short name or ``module:attribute``, not blank. Whether it loads is
     :func:`conformance.sync.load`'s to say; this refuses only what cannot be a spec at all."""
-    should = f"a short name ({', '.join(SHORT_SYNC_NAMES)}) or 'module:attribute'"
+    should = f"a short name ({', '.join(SHORT_NAMES)}) or 'module:attribute'"
     if not isinstance(value, str) or not value.strip():
         raise _refuse(name, value, should, default_hint)
     return value.strip()
@@ -370,9 +372,7 @@ def plugin_option(config, name: str) -> Any:
     if name == "report":
         return report_path(label, value)
     if name == "isolation":
-        from conformance.crashes import CHOICES
-
-        return choice(label, value, CHOICES)
+        return choice(label, value, ISOLATION_CHOICES)
     if name == "image_tolerance":
         return choice(label, value, IMAGE_TOLERANCE_CHOICES)
     if name == "golden_dir":

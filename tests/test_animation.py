@@ -18,7 +18,7 @@ from PIL import Image, ImageSequence
 
 from conformance import animation, cli, scenes
 from conformance.rendering import outline
-from conformance.pytest_helpers import reproduce_command
+from conformance.printed import reproduce_command
 
 
 def _render(argv, cwd: Path) -> tuple[int, str, str]:

@@ -275,9 +275,7 @@ def test_sync_precedence_and_default():
 def test_the_validators_know_the_kit_s_own_names():
     from conformance import plugin
 
-    assert set(validation.SHORT_SYNC_NAMES) == set(sync.SHORT_NAMES)
     assert set(validation.TOLERANCE_OPTIONS) == set(plugin._TOLERANCE_OPTIONS)
-    assert validation.SYNC_ENV_VAR == sync.ENV_VAR
 
 
 def test_validators_for_the_other_commands(tmp_path, monkeypatch):

@@ -21,7 +21,7 @@ import pytest
 
 from children import environment, run as run_child, said
 from conformance import backends, runner, scenes, sync
-from conformance.rendering import compare, golden, measure_reftest, measure_tolerances, reftest, snapshots
+from conformance.rendering import golden, measure_reftest, measure_tolerances, reftest, snapshots
 
 TESTS = Path(__file__).resolve().parent
 SCENE = "free_fall"

@@ -12,7 +12,7 @@ from pathlib import Path
 
 
 from conformance import apps, printed
-from conformance.pytest_helpers import reproduce_command
+from conformance.printed import reproduce_command
 from conformance.rendering.golden import regen_command
 
 import app_sources

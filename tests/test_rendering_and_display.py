@@ -39,8 +39,6 @@ def test_virtual_display_is_started_and_stopped(monkeypatch):
     monkeypatch.delenv("DISPLAY", raising=False)
     monkeypatch.setattr(display, "_started", None)
     with display.virtual_display():
-        import os
-
         assert os.environ.get("DISPLAY", "").startswith(":")
         assert display._started is not None
     assert display._started is None and "DISPLAY" not in __import__("os").environ

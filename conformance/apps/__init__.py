@@ -17,9 +17,10 @@ import json
 import shlex
 from dataclasses import dataclass, field
 
-from conformance.apps.judge import CHECKS, DIAGNOSES, Verdict, judge
+from conformance.apps.judge import CHECKS, judge
 from conformance.apps.launch import AppFailed, KitFailed, record
 from conformance.apps.recording import Recording
+from conformance.apps.verdict import DIAGNOSES, Verdict
 
 __all__ = ["CHECKS", "DIAGNOSES", "AppFailed", "AppResult", "KitFailed", "Recording", "Verdict", "check_app", "judge", "record",
            "reproduce_command"]

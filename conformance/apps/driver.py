@@ -28,7 +28,6 @@ import os
 import sys
 import time
 import traceback
-from types import SimpleNamespace
 
 import numpy as np
 import pybullet

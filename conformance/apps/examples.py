@@ -40,7 +40,7 @@ class Expectation:
 
 def expectation(path) -> Expectation:
     """The ``EXPECT:``/``MISTAKE:`` lines of the app at ``path``, validated."""
-    from conformance.apps.judge import DIAGNOSES
+    from conformance.apps.verdict import DIAGNOSES
 
     path = Path(path)
     try:

@@ -19,7 +19,12 @@ import numpy as np
 
 from conformance.apps import picture
 
-__all__ = ["camera", "faces"]
+__all__ = ["SIZE", "camera", "faces"]
+
+#: The size of the app's window under the kit (off-screen): the checks read vertices, not pixels, and
+#: the app's own size (900×768, say) made its renders most of an app's run on the CPU. A picture is
+#: taken at its own size and the window put back to this one.
+SIZE = (64, 64)
 
 _ARRAY = "conformance-face-codes"
 
@@ -68,8 +73,6 @@ def faces(showm, actors, cam, size, gpu=None) -> dict:
     """Render the app's ``actors`` in its own window from ``cam`` at ``size``; see :func:`picture.take`."""
     from vtkmodules.util import numpy_support
     from vtkmodules.vtkRenderingCore import vtkProperty, vtkWindowToImageFilter
-
-    from conformance.apps.takeover_vtk import SIZE
 
     scene, window = showm.scene, showm.window
     datas = [a.GetMapper().GetInput() for a in actors]

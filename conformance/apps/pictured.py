@@ -243,7 +243,7 @@ def _diagnosis(frame: int, shot: dict, recording, attachments) -> str:
 def check(judgement):
     """The ``pictured`` verdict of a :class:`~conformance.apps.judge._Judgement`, with each picture's
     comparison record and, for a failure, its three pictures (``Verdict.pictures``)."""
-    from conformance.apps.judge import DIAGNOSES, Verdict
+    from conformance.apps.verdict import DIAGNOSES, Verdict
 
     r = judgement.r
     verdict = Verdict("pictured", True)

@@ -13,10 +13,9 @@ from __future__ import annotations
 
 __all__ = ["install", "scene_actors"]
 
+from conformance.apps.picture_vtk import SIZE
+
 KIND = "FURY 0.12 ShowManager"
-#: The size of the app's window under the kit (off-screen): the checks read vertices, not pixels, and
-#: the app's own size (900×768, say) made its renders most of an app's run on the CPU.
-SIZE = (64, 64)
 
 
 class _Source:

@@ -31,22 +31,21 @@ from typing import Any, Callable, Iterable
 
 import numpy as np
 
-from conformance.errors import GoldenMissing, GoldenUnreadable
+from conformance.errors import GoldenError, GoldenMissing, GoldenUnreadable
 from conformance.files import encode_png, write_atomically
+from conformance.own_scenes import default_dir  # where a scene's goldens live is own_scenes' to say
 
-__all__ = ["FORMAT", "Golden", "default_dir", "encode_manifest", "jsonable", "library_versions", "paths", "read", "regen_command", "stale", "stale_by_directory", "write"]
+__all__ = ["FORMAT", "Golden", "default_dir", "encode_manifest", "jsonable", "library_versions", "paths", "read", "regen_command", "same_renderer", "stale", "stale_by_directory", "write"]
 
 #: The manifest format; bumped when its meaning changes, so an old manifest is refused, not misread.
 FORMAT = 1
 _REQUIRED = ("format", "scene", "params", "frame", "camera", "size", "sync", "renderer", "versions", "state")
 
 
-def default_dir() -> Path:
-    """The goldens shipped with the kit for the backend in force: ``golden/<backend>/`` in a checkout,
-    ``conformance/golden/<backend>/`` in a wheel (renderers differ, so each backend has its own)."""
-    from conformance import backends
-
-    return Path(__file__).resolve().parent.parent / "golden" / backends.NAME
+def same_renderer(made_by: dict[str, str], here: dict[str, str]) -> bool:
+    """Whether a golden was made by the renderer this machine has: the same backend, library versions
+    and GPU (OpenGL strings for VTK, the wgpu adapter for pygfx), every key either side names."""
+    return all(made_by.get(k) == here.get(k) for k in set(made_by) | set(here))
 
 
 def paths(directory: Path | str, scene: str, frame: int) -> tuple[Path, Path]:

@@ -74,7 +74,7 @@ def measure_scene(scene_name: str) -> list[dict]:
     for frame, g in goldens.items():
         ref = references[frame]
         chosen, why = reftest.renderer_tolerance(g, ref, here)
-        by_name = compare.SAME_RENDERER if snapshots.same_renderer(g.renderer, here) else compare.OTHER_RENDERER
+        by_name = compare.SAME_RENDERER if golden.same_renderer(g.renderer, here) else compare.OTHER_RENDERER
         row = {"scene": scene_name, "frame": frame,
                "allowed": int(compare.SAME_RENDERER.max_differing_fraction * ref.shape[0] * ref.shape[1]),
                "renderer": {**_counts(g.image, ref), "set": chosen.name, "why": why,

@@ -79,11 +79,9 @@ def renderer_tolerance(golden: storage.Golden, reference: np.ndarray, here: Mapp
     changed rendering stack under the same name must show), or when the pictures themselves agree
     within it although the names differ (zink draws llvmpipe's goldens to 0 pixels: the name
     misleads, the pictures do not). Else ``other-renderer``: anti-aliasing and rounding differ."""
-    from conformance.rendering import snapshots
-
     if override:
         return compare.tolerance(override), f"{override}, as asked"
-    if snapshots.same_renderer(golden.renderer, here):
+    if storage.same_renderer(golden.renderer, here):
         return compare.SAME_RENDERER, "the golden's manifest names this renderer"
     tight = compare.SAME_RENDERER
     # The pixel count first: where it already exceeds the tight set, FLIP (~0.1 s) need not be computed.

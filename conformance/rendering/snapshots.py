@@ -32,15 +32,10 @@ from conformance.rendering import framing
 from conformance.rendering import golden as storage
 from conformance.rendering.records import ImageCheck
 
-__all__ = ["Change", "check_physics", "check_render", "draw", "make", "only_float_noise", "regenerate",
-           "same_renderer"]
+__all__ = ["Change", "check_physics", "check_render", "draw", "make", "only_float_noise", "regenerate"]
 
 #: The sync whose drawing the goldens show.
 GOLDEN_SYNC = "reference"
-def same_renderer(made_by: dict[str, str], here: dict[str, str]) -> bool:
-    """Whether a golden was made by the renderer this machine has: the same backend, library versions
-    and GPU (OpenGL strings for VTK, the wgpu adapter for pygfx), every key either side names."""
-    return all(made_by.get(k) == here.get(k) for k in set(made_by) | set(here))
 
 
 def manifest(run, frame: int, captured: dict[str, Any], renderer: dict[str, str]) -> dict[str, Any]:

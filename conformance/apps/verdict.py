@@ -1,0 +1,73 @@
+"""A verdict of app mode (one check on one recording) and the catalogue of mistakes it can name.
+
+Kept apart from :mod:`conformance.apps.judge`, which makes the verdicts, so that the checks it hands off
+(:mod:`conformance.apps.pictured`) build theirs without importing it back."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from conformance.apps import attachment as attach_mod
+
+__all__ = ["DIAGNOSES", "Verdict"]
+
+#: diagnosis id → what it means, for the docs and every failure line
+DIAGNOSES = {name: text for name, (text, _) in attach_mod.VARIANTS.items()} | {
+    "com-frame": "drawn at the centre-of-mass frame (getBasePositionAndOrientation, or getLinkState()[0:2]) instead "
+                 "of the link frame: undo getDynamicsInfo(body, link)[3:5], or read getLinkState()[4:6]",
+    "never-moved": "left where it was built while its body moves: the sync never sets this actor (or this range)",
+    "other-body": "follows another body's frame: the vertex range or the actor was paired with the wrong body",
+    "turned-shape": "the actor was built turned in its body's frame (a box's directions, a cylinder's axis)",
+    "offset-sign": "drawn with the centre-of-mass offset applied the wrong way (twice its offset from the link frame, or "
+                   "undone twice): the link frame is the centre of mass moved by minus getDynamicsInfo(body, link)[3:5], "
+                   "turned by the centre of mass's orientation",
+    "visual-frame": "drawn without its visual frame: a URDF places each visual shape in its link frame "
+                    "(getVisualShapeData(body)[i][5:7], the <visual><origin>), which the actor must be moved by",
+    "mesh-scale": "drawn without its mesh scale: getVisualShapeData(body)[i][3] (the URDF's <mesh scale>) scales the "
+                  "mesh file's vertices",
+    "stale-normals": "the vertices turn but the stored normals do not: turn normals with the same rotation",
+    "unannounced": "vertex data changed without telling the renderer, which keeps drawing the old data: call "
+                   "utils.update_actor (FURY 0.12); on FURY 2 call update_range (or update_full) on every buffer "
+                   "changed, positions and normals, covering each changed range",
+    "written-back": "the pose that was drawn (as read, or rounded to float32) is written back into pyBullet "
+                    "(\"so physics and graphics agree\"): resetBasePositionAndOrientation also sets the body's "
+                    "velocity to zero (pybullet 3.2.7), so the simulation is changed; a sync only reads",
+    "hidden": "its actor is hidden (SetVisibility(0) on FURY 0.12, visible = False on FURY 2) or drawn fainter than "
+              "opacity 32/255, so the picture does not show a body pyBullet has there: keep each body's actor shown",
+    "not-its-shape": "nothing draws the shape pyBullet has for this body: every drawing it holds is another shape "
+                     "(another size, or turned) than its visual shapes (getVisualShapeData) or, without them, its "
+                     "collision shape, and the picture differs from pyBullet's own: build the actor from those "
+                     "shapes' dimensions, frames and scales",
+    "skipped": "drawn where it was before the tick's step at some ticks only: at other ticks where pyBullet moved it "
+               "it is drawn right, so the sync is not late but skips the body on some condition (zero velocity, "
+               "a sleeping flag, a pose it takes as unchanged, every other call): draw every body whenever the "
+               "sync is called (README, \"The sync protocol\")",
+    "node-order": "drawn at another node than the one it follows: the actor's vertices were built in another order "
+                  "than the nodes are copied into them (a mesh file read by another library reorders or merges "
+                  "vertices): build the actor from getMeshData(body, -1, flags=p.MESH_DATA_SIMULATION_MESH) and copy "
+                  "the nodes in that same order",
+    "stale-gpu": "the GPU still holds older vertices of this body: the vertices were written but the range announced "
+                 "with positions.update_range(offset, count) does not cover them (offset and count are in vertices); "
+                 "announce every range written, or update_full()",
+}
+
+
+@dataclass
+class Verdict:
+    check: str
+    passed: bool
+    lines: list = field(default_factory=list)
+    diagnoses: list = field(default_factory=list)
+    worst: float | None = None      # worst error / allowance, where the check measures one
+    notes: list = field(default_factory=list)
+    #: (ImageCheck, pictures by role) of each picture compared (``pictured``): the artefacts to keep
+    pictures: list = field(default_factory=list)
+
+    def message(self) -> str:
+        return "\n".join(self.lines)
+
+    def diagnosed(self, diagnosis: str) -> None:
+        """Name the mistake (a key of :data:`DIAGNOSES`) under the last line, if there is one."""
+        if diagnosis:
+            self.lines.append(f"    diagnosis: {DIAGNOSES[diagnosis]}")
+            self.diagnoses.append(diagnosis)
