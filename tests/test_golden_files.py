@@ -141,3 +141,12 @@ def test_unreadable_file_is_reported_not_raised_as_os_error(stored):
         png.chmod(0)
     with pytest.raises(GoldenUnreadable, match="cannot be read"):
         _read(stored)
+
+
+def test_a_damaged_old_golden_is_no_picture_to_compare_a_remade_one_with(stored):
+    """``regen`` compares a remade golden with the stored picture when the old one no longer fits the
+    scene; a stored PNG that does not decode is no picture (None), not an error of the kit's own."""
+    assert golden.picture_of(stored, SCENE, FRAME).shape == (SIZE[1], SIZE[0], 3)
+    _damage(stored, 0, golden.paths(stored, SCENE, FRAME)[0].read_bytes()[:60])
+    assert golden.picture_of(stored, SCENE, FRAME) is None
+    assert golden.picture_of(stored, "no_such_scene", FRAME) is None
