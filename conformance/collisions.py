@@ -26,7 +26,6 @@ __all__ = [
     "PairFilter",
     "Pair",
     "describe_calls",
-    "drawn_overlap",
     "group_mask_rule",
     "observe",
     "pair_of",
@@ -180,33 +179,3 @@ def observe(scene, frames: int, calls: Iterable[Any] = ()) -> Outcome:
 
 def describe_calls(calls: Sequence[Any], pair: Pair) -> str:
     return "; ".join(c.describe(pair) for c in calls) or "no filter calls"
-
-
-
-def drawn_overlap(drawing, names: tuple[str, str] = ("a", "b")) -> tuple[dict[str, bool], float]:
-    """Read back what the renderer draws for the two bodies: whether each one's drawn centre (the
-    mean of its drawn vertices) lies inside the other's drawn shape (the convex hull of its drawn
-    vertices), and the distance between the drawn centres."""
-    from scipy.spatial import ConvexHull, QhullError
-
-    from conformance import backends
-
-    drawn = {}
-    for target in drawing.targets:
-        if target.name in names:
-            drawn[target.name] = backends.world_vertices(target.actor)[target.start:target.stop]
-    centres = {name: points.mean(axis=0) for name, points in drawn.items()}
-    inside = {}
-    for name, other in (names, names[::-1]):
-        if not (np.isfinite(drawn[other]).all() and np.isfinite(centres[name]).all()):
-            inside[name] = False
-            continue
-        try:
-            hull = ConvexHull(drawn[other])
-        except QhullError:  # drawn flat or as one point: nothing lies inside
-            inside[name] = False
-            continue
-        scale = float(np.ptp(drawn[other], axis=0).max())
-        margin = hull.equations[:, :3] @ centres[name] + hull.equations[:, 3]
-        inside[name] = bool((margin <= 1e-9 * scale).all())
-    return inside, float(np.linalg.norm(centres[names[0]] - centres[names[1]]))

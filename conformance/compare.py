@@ -23,6 +23,7 @@ __all__ = [
     "compare_collision_geometry",
     "compare_normals",
     "compare_vertices",
+    "drawn_overlap",
 ]
 
 
@@ -286,3 +287,30 @@ def compare_bounds(drawing: Drawing, frame: int, tolerance: Tolerance = DEFAULT)
                                  f"(margin {margin[axis]:.3g} m)")
         results.append(BoundsResult(drawing.world.scene, t.name, frame, tuple(found)))
     return results
+
+
+def drawn_overlap(drawing, names: tuple[str, str] = ("a", "b")) -> tuple[dict[str, bool], float]:
+    """Read back what the renderer draws for the two bodies: whether each one's drawn centre (the
+    mean of its drawn vertices) lies inside the other's drawn shape (the convex hull of its drawn
+    vertices), and the distance between the drawn centres."""
+    from scipy.spatial import ConvexHull, QhullError
+
+    drawn = {}
+    for target in drawing.targets:
+        if target.name in names:
+            drawn[target.name] = backends.world_vertices(target.actor)[target.start:target.stop]
+    centres = {name: points.mean(axis=0) for name, points in drawn.items()}
+    inside = {}
+    for name, other in (names, names[::-1]):
+        if not (np.isfinite(drawn[other]).all() and np.isfinite(centres[name]).all()):
+            inside[name] = False
+            continue
+        try:
+            hull = ConvexHull(drawn[other])
+        except QhullError:  # drawn flat or as one point: nothing lies inside
+            inside[name] = False
+            continue
+        scale = float(np.ptp(drawn[other], axis=0).max())
+        margin = hull.equations[:, :3] @ centres[name] + hull.equations[:, 3]
+        inside[name] = bool((margin <= 1e-9 * scale).all())
+    return inside, float(np.linalg.norm(centres[names[0]] - centres[names[1]]))

@@ -13,9 +13,9 @@ import subprocess
 import sys
 from typing import Any, Mapping
 
-from conformance import scenes
+from conformance import scenes, state
 
-__all__ = ["MAX_STEPS", "digest", "digests_in_subprocess"]
+__all__ = ["MAX_STEPS", "digest", "digests_in_subprocess", "first_divergence"]
 
 #: Default run length: the scene's own, capped (the tumbling scene runs 10,000 frames).
 MAX_STEPS = 400
@@ -58,3 +58,17 @@ def digests_in_subprocess(names: list[str], steps: int | None = None) -> dict[st
     if out.returncode != 0:
         raise RuntimeError(f"the fresh process computing scene digests failed:\n{out.stderr[-2000:]}")
     return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def first_divergence(scene_name: str, steps: int, distance: float = 1e-9) -> int | None:
+    """The first step after which a run nudged by ``distance`` (:func:`conformance.state.nudged`) differs from the
+    plain run beyond the physics verdict's tolerance, or None within ``steps``: where a scene's
+    physics turns chaotic, measured."""
+    with scenes.build(scene_name) as plain, scenes.build(scene_name) as moved:
+        state.nudged(moved, distance)
+        for step in range(steps):
+            plain.advance(step)
+            moved.advance(step)
+            if not state.compare(state.capture(moved), state.capture(plain)).ok:
+                return step + 1
+    return None

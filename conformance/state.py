@@ -22,7 +22,7 @@ import numpy as np
 
 from conformance import truth
 
-__all__ = ["FLOAT_NOISE", "NOISE_SHARE", "NOISE_STEP", "FloatNoise", "PhysicsDifference", "capture", "compare", "first_divergence", "float_noise",
+__all__ = ["FLOAT_NOISE", "NOISE_SHARE", "NOISE_STEP", "FloatNoise", "PhysicsDifference", "capture", "compare", "float_noise",
            "nudged", "restore"]
 
 #: Physics verdict: a live target farther than this from its stored link-frame pose is a difference.
@@ -138,22 +138,6 @@ def nudged(scene, distance: float = 1e-9) -> None:
             linear, angular = p.getBaseVelocity(body)
             p.resetBasePositionAndOrientation(body, [x + distance, y, z], orientation)
             p.resetBaseVelocity(body, linear, angular)
-
-
-def first_divergence(scene_name: str, steps: int, distance: float = 1e-9) -> int | None:
-    """The first step after which a run nudged by ``distance`` (:func:`nudged`) differs from the
-    plain run beyond the physics verdict's tolerance, or None within ``steps``: where a scene's
-    physics turns chaotic, measured."""
-    from conformance import scenes
-
-    with scenes.build(scene_name) as plain, scenes.build(scene_name) as moved:
-        nudged(moved, distance)
-        for step in range(steps):
-            plain.advance(step)
-            moved.advance(step)
-            if not compare(capture(moved), capture(plain)).ok:
-                return step + 1
-    return None
 
 
 @dataclass(frozen=True)

@@ -23,7 +23,6 @@ from conformance.collisions import (
     GroupMask,
     PairFilter,
     describe_calls,
-    drawn_overlap,
     group_mask_rule,
     observe,
     pair_of,
@@ -143,7 +142,7 @@ def verify_drawn_overlap(params, implementation) -> None:
         x_b = p.getBasePositionAndOrientation(pair.b)[0][0]
         where = context(SCENE, run.scene.params, f"frame {run.frame}", f"sync {implementation.spec!r}")
         assert_interpenetrating(contacts=contacts, distance=abs(x_b - x_a), depth=timeline.depth, where=where)
-        inside, distance = drawn_overlap(run.drawing)
+        inside, distance = compare.drawn_overlap(run.drawing)
         assert_drawn_overlapping(inside=inside, distance=distance, where=where)
         assert_vertices_match(compare.compare_vertices(run.drawing, run.frame), run=run, sync=implementation.spec)
 

@@ -15,41 +15,8 @@ from hypothesis import given, strategies as st
 from conformance import backends, image_options, scenes, shared_run, strategies
 from conformance.events import Teleport
 from conformance.profiles import check_settings
-from conformance.printed import reproduce_command, rerun_check
 from conformance.pytest_helpers import _context, each_scene
 from conformance.rendering import framing, golden, silhouettes
-
-def silhouette_check(run, sync: str, pictures=None, nodeid: str = "", check: str = "test_silhouettes_match_in_any_orientation",
-                     tolerance=None):
-    """FURY's ID render against pyBullet's mask for the run's current frame, as an ImageCheck (kept,
-    with its masks when it failed, in the results directory when ``pictures`` is given); its reproduce
-    line runs ``check`` (a whole pytest id, or a check's name) again."""
-    scene = run.scene
-    ids_fury = backends.render_ids(run.drawing, scene.camera, scene.image_size)
-    ids_bullet = silhouettes.pybullet_mask(scene, scene.bindings, scene.camera, scene.image_size)
-    record = _record(run, sync, ids_fury, ids_bullet, check, tolerance)
-    record.nodeid = nodeid
-    if pictures is not None:
-        pictures.keep(record, silhouettes.mask_images(ids_fury, ids_bullet))
-    return record
-
-
-def _record(run, sync: str, ids_fury, ids_bullet, check: str, tolerance=None):
-    scene = run.scene
-    record = silhouettes.compare_silhouettes(
-        ids_fury, ids_bullet, min_iou=silhouettes.thresholds(scene.bindings), rounding=silhouettes.roundings(scene.bindings),
-        discs=silhouettes.projected_discs(scene, scene.bindings, scene.camera, scene.image_size),
-        radii=silhouettes.projected_radii(scene, scene.bindings, scene.camera, scene.image_size),
-        names=[t.name for t in run.drawing.targets], scene=scene.name, frame=run.frame,
-        touching=silhouettes.touching_pairs(scene, scene.bindings, ids_fury, ids_bullet))
-    record.sync = sync
-    record.params = golden.jsonable(dict(run.params))
-    # The check itself reruns it (`check` compares vertices, not silhouettes); the frame-by-frame replay
-    # of the same run shows whether its vertices are wrong too.
-    record.reproduce = rerun_check(check, scene.name, sync, tolerance)
-    record.details["replay"] = reproduce_command(scene.name, sync, run.frame, run.params, run.events, tolerance)
-    return record
-
 
 def assert_passed(record, run, sync: str) -> None:
     __tracebackhide__ = True
@@ -69,7 +36,7 @@ def _silhouettes(run, kit):
     scene = run.scene
     ids_fury = backends.render_ids(run.drawing, scene.camera, scene.image_size)
     ids_bullet = silhouettes.pybullet_mask(scene, scene.bindings, scene.camera, scene.image_size)
-    record = _record(run, kit.sync, ids_fury, ids_bullet, f"test_silhouettes_match_pybullet_at_golden_frames[{scene.name}]",
+    record = silhouettes.silhouette_record(run, kit.sync, ids_fury, ids_bullet, f"test_silhouettes_match_pybullet_at_golden_frames[{scene.name}]",
                      kit.tolerance)
     config = kit._node.config  # None outside a pytest session: nothing is kept then but failures
     keep = not record.passed or (config is not None and image_options.from_config(config).keep_passing)
@@ -131,6 +98,6 @@ def test_silhouettes_match_in_any_orientation(kit):
     def check(scene_name, turns):
         events = [Teleport(0, which, (0.0, 0.0, 0.0), orientation) for which, orientation in turns]
         with kit.run(scene_name, events=events) as run:
-            assert_passed(silhouette_check(run, kit.sync, tolerance=kit.tolerance), run, kit.sync)
+            assert_passed(silhouettes.silhouette_check(run, kit.sync, tolerance=kit.tolerance), run, kit.sync)
 
     check()

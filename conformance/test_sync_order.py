@@ -75,7 +75,7 @@ def rerun_command(scene: str, sync: str) -> str:
 
 def machine(kit: Kit, scene_name: str) -> type[RuleBasedStateMachine]:
     """The state machine over ``scene_name`` for the sync under ``kit``."""
-    from conformance.test_silhouettes import silhouette_check
+    from conformance.rendering.silhouettes import silhouette_check
 
     # A default-mode Kit raises at the first wrong frame, which is what ends a Hypothesis example.
     checker = Kit(kit.implementation, kit.tolerance, survey=False)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from conformance import scenes, state
+from conformance import determinism, scenes, state
 
 
 @pytest.mark.parametrize("scene_name", scenes.names())
@@ -14,7 +14,7 @@ def test_chaotic_after_is_where_a_nanometre_nudge_diverges(scene_name):
     the golden physics check is lenient where, and only where, another platform's rounding may show."""
     spec = scenes.get(scene_name)
     last = max(spec.frames_with_goldens())
-    diverges = state.first_divergence(scene_name, last)
+    diverges = determinism.first_divergence(scene_name, last)
     assert (None if diverges is None else diverges - 1) == spec.chaotic_after, (
         f"{scene_name}: a 1 nm nudge diverges after step {diverges}, but chaotic_after={spec.chaotic_after}")
 

@@ -74,7 +74,7 @@ def test_a_reproduce_line_keeps_the_tolerance_its_run_was_given(tmp_path):
 def test_a_silhouette_failure_reproduces_with_the_check_itself_not_with_check():
     """`check` compares vertices only: a silhouette's reproduce line reruns the silhouette check."""
     from conformance import runner, sync
-    from conformance.test_silhouettes import silhouette_check
+    from conformance.rendering.silhouettes import silhouette_check
 
     with runner.running("free_fall", sync.load("reference")) as run:
         record = silhouette_check(run, "reference", check="test_silhouettes_match_pybullet_at_golden_frames[free_fall]")

@@ -51,7 +51,8 @@ from . import projection
 from .records import ImageCheck
 
 __all__ = ["LEAST_OFF", "MIN_IOU", "MIN_PIXELS", "ROUNDING", "SLACK", "TOUCHING", "compare_silhouettes", "mask_images",
-           "projected_discs", "projected_radii", "pybullet_mask", "rounded_slacks", "roundings", "thresholds", "touching_pairs"]
+           "projected_discs", "projected_radii", "pybullet_mask", "rounded_slacks", "roundings", "silhouette_check", "silhouette_record", "thresholds",
+           "touching_pairs"]
 
 #: A target is judged only where it covers at least this many pixels in either mask: below that its
 #: IoU is dominated by which edge pixels each rasteriser keeps.
@@ -381,3 +382,40 @@ def mask_images(ids_fury: np.ndarray, ids_pybullet: np.ndarray) -> dict[str, np.
     difference[(ids_fury < 0) & (ids_pybullet >= 0)] = (0, 0, 255)
     difference[(ids_fury >= 0) & (ids_pybullet >= 0) & ~same] = (255, 255, 0)
     return {"fury_mask": palette[ids_fury], "pybullet_mask": palette[ids_pybullet], "mask_difference": difference}
+
+
+def silhouette_check(run, sync: str, pictures=None, nodeid: str = "", check: str = "test_silhouettes_match_in_any_orientation",
+                     tolerance=None):
+    """FURY's ID render against pyBullet's mask for the run's current frame, as an ImageCheck (kept,
+    with its masks when it failed, in the results directory when ``pictures`` is given); its reproduce
+    line runs ``check`` (a whole pytest id, or a check's name) again."""
+    from conformance import backends
+
+    scene = run.scene
+    ids_fury = backends.render_ids(run.drawing, scene.camera, scene.image_size)
+    ids_bullet = pybullet_mask(scene, scene.bindings, scene.camera, scene.image_size)
+    record = silhouette_record(run, sync, ids_fury, ids_bullet, check, tolerance)
+    record.nodeid = nodeid
+    if pictures is not None:
+        pictures.keep(record, mask_images(ids_fury, ids_bullet))
+    return record
+
+
+def silhouette_record(run, sync: str, ids_fury, ids_bullet, check: str, tolerance=None):
+    scene = run.scene
+    record = compare_silhouettes(
+        ids_fury, ids_bullet, min_iou=thresholds(scene.bindings), rounding=roundings(scene.bindings),
+        discs=projected_discs(scene, scene.bindings, scene.camera, scene.image_size),
+        radii=projected_radii(scene, scene.bindings, scene.camera, scene.image_size),
+        names=[t.name for t in run.drawing.targets], scene=scene.name, frame=run.frame,
+        touching=touching_pairs(scene, scene.bindings, ids_fury, ids_bullet))
+    from conformance.printed import reproduce_command, rerun_check
+    from conformance.rendering.golden import jsonable
+
+    record.sync = sync
+    record.params = jsonable(dict(run.params))
+    # The check itself reruns it (`check` compares vertices, not silhouettes); the frame-by-frame replay
+    # of the same run shows whether its vertices are wrong too.
+    record.reproduce = rerun_check(check, scene.name, sync, tolerance)
+    record.details["replay"] = reproduce_command(scene.name, sync, run.frame, run.params, run.events, tolerance)
+    return record
