@@ -11,7 +11,7 @@ and the process that started pytest survives to give the verdict. What is guaran
   without the kit. A run given ``-n`` is already in workers. It is not isolated under ``--pdb`` or
   ``--trace`` (a debugger needs the test in the terminal's process), nor without pytest-xdist.
 * **A crash is a verdict.** Each worker notes, before every call into the sync, the check, the scene and
-  the step (one ``pwrite`` into a small file: :class:`Journal`), and has :mod:`faulthandler` write the
+  the step (one ``pwrite`` into a small file: :class:`conformance.crash_journal.Journal`), and has :mod:`faulthandler` write the
   stack to a file when the process dies of a signal. When a worker dies, its check fails with one
   paragraph: "the process crashed", the signal or exit status, the scene and step, the sync's stack
   as faulthandler wrote it (Python frames, innermost last; a native library's own frames are not
@@ -27,8 +27,6 @@ and the process that started pytest survives to give the verdict. What is guaran
 
 from __future__ import annotations
 
-import faulthandler
-import hashlib
 import json
 import os
 import shutil
@@ -40,17 +38,12 @@ from pathlib import Path
 
 import pytest
 
-from conformance.errors import SyncCrashed
+from conformance.crash_journal import INPUT_KEY, crash_file, when
 
-__all__ = ["Controller", "Journal", "Watchdog", "allow_restarts", "arrange", "at", "check_not_crashed",
-           "hard_limit", "noting", "returned", "start_journal"]
+__all__ = ["Controller", "Watchdog", "allow_restarts", "arrange", "hard_limit"]
 
-_INPUT_KEY = "conformance_crash_dir"
 #: Restarts allowed beyond xdist's own (four per worker): one crash per scene at most (see above).
 _RESTARTS_PER_SCENE = 1
-_RECORD_SIZE = 4096
-
-_journal: "Journal | None" = None
 
 
 def arrange(config, sync_spec: str, mode: str) -> bool:
@@ -76,72 +69,6 @@ def allow_restarts(config, scenes: int) -> None:
         config.option.maxworkerrestart = str(4 * workers + _RESTARTS_PER_SCENE * scenes)
 
 
-# -- in a worker ------------------------------------------------------------------------------------
-
-class Journal:
-    """Where this worker is: the check, the sync's scene and step, rewritten in place before each call
-    into the sync, so that it is on disk (in the page cache) whatever kills the process next."""
-
-    def __init__(self, directory: Path, worker: str):
-        self.directory = directory
-        self._fd = os.open(directory / f"{worker}.where", os.O_RDWR | os.O_CREAT | os.O_TRUNC, 0o600)
-        self._stack = open(directory / f"{worker}.stack", "w")  # noqa: SIM115 - open for the process's life
-        faulthandler.enable(file=self._stack, all_threads=False)
-        self.nodeid = ""
-        self.where: dict = {}
-
-    def note(self, **where) -> None:
-        self.where = where
-        data = json.dumps({"nodeid": self.nodeid, "pid": os.getpid(), **where}).encode("utf-8")[:_RECORD_SIZE - 1]
-        os.pwrite(self._fd, data.ljust(_RECORD_SIZE, b" "), 0)
-
-    def crashed(self, spec: str, scene: str) -> dict | None:
-        path = _crash_file(self.directory, spec, scene)
-        return json.loads(path.read_text()) if path.exists() else None
-
-
-def start_journal(config) -> None:
-    """In a worker given a crash directory by the controller: keep the journal from now on."""
-    global _journal
-    directory = getattr(config, "workerinput", {}).get(_INPUT_KEY)
-    if directory:
-        _journal = Journal(Path(directory), config.workerinput["workerid"])
-
-
-def noting(nodeid: str) -> None:
-    """The check that starts now (``pytest_runtest_logstart``)."""
-    if _journal is not None:
-        _journal.nodeid = nodeid
-        _journal.note(scene=None, step=None)
-
-
-def at(scene: str, step: int | None) -> None:
-    """The sync is about to be called on ``scene`` at ``step`` (``None``: its factory); the controller's
-    watchdog (:class:`Watchdog`) times the call from now."""
-    if _journal is not None:
-        _journal.note(scene=scene, step=step, since=time.time())
-
-
-def returned() -> None:
-    """The call into the sync returned (or raised): the watchdog stops timing it; where it was stays noted."""
-    if _journal is not None and _journal.where.get("since") is not None:
-        _journal.note(**{**_journal.where, "since": None})
-
-
-def check_not_crashed(spec: str, scene: str) -> None:
-    """Raise :class:`SyncCrashed` when ``spec`` already crashed a worker on ``scene`` in this run."""
-    crash = _journal.crashed(spec, scene) if _journal is not None else None
-    if crash is not None:
-        raise SyncCrashed(
-            f"sync implementation {spec!r} crashed the process on scene {scene!r} {_when(crash['step'])} in "
-            f"{crash['nodeid']} ({crash['how']}); this check would run the scene with it again, so it fails "
-            "without running (see that check's failure for the stack).")
-
-
-def _when(step) -> str:
-    return "while being set up" if step is None else f"at step {step}"
-
-
 # -- in the controller ------------------------------------------------------------------------------
 
 class Controller:
@@ -156,7 +83,7 @@ class Controller:
         self.watchdog = Watchdog(self.directory, limit) if limit else None
 
     def pytest_configure_node(self, node) -> None:
-        node.workerinput[_INPUT_KEY] = str(self.directory)
+        node.workerinput[INPUT_KEY] = str(self.directory)
 
     @pytest.hookimpl(wrapper=True)
     def pytest_runtestloop(self, session):
@@ -185,9 +112,9 @@ class Controller:
         if scene is not None:
             from conformance.files import write_atomically
 
-            write_atomically(_crash_file(self.directory, self.sync_spec, scene), json.dumps(
+            write_atomically(crash_file(self.directory, self.sync_spec, scene), json.dumps(
                 {"nodeid": crashitem, "step": step, "how": how}).encode("utf-8"))
-        place = (f"while sync implementation {self.sync_spec!r} ran on scene {scene!r} {_when(step)}" if scene
+        place = (f"while sync implementation {self.sync_spec!r} ran on scene {scene!r} {when(step)}" if scene
                  else "outside any call into the sync (the kit's own work, or the sync's module)")
         message = (f"the process crashed ({how}) {place}. The run went on in a new process; this scene's other "
                    "checks with this sync fail without running it again.\n"
@@ -277,11 +204,6 @@ class Watchdog:
                     os.kill(pid, signal.SIGABRT)
                 except ProcessLookupError:
                     hung.unlink()
-
-
-def _crash_file(directory: Path, spec: str, scene: str) -> Path:
-    """Where a crash of ``spec`` on ``scene`` is kept: per sync, since a check may also run the kit's own."""
-    return directory / "crashed" / hashlib.sha1(f"{spec}\0{scene}".encode()).hexdigest()
 
 
 def _read(path: Path) -> str:

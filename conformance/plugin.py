@@ -264,15 +264,15 @@ def _watch_for_crashes(config: pytest.Config) -> None:
 
 def pytest_sessionstart(session: pytest.Session) -> None:
     if hasattr(session.config, "workerinput"):  # after pytest's own faulthandler set-up, which it replaces
-        from conformance import crashes
+        from conformance import crash_journal
 
-        crashes.start_journal(session.config)
+        crash_journal.start_journal(session.config)
 
 
 def pytest_runtest_logstart(nodeid: str, location) -> None:
-    from conformance import crashes
+    from conformance import crash_journal
 
-    crashes.noting(nodeid)
+    crash_journal.noting(nodeid)
 
 
 def pytest_unconfigure(config: pytest.Config) -> None:

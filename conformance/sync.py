@@ -26,7 +26,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable
 
-from conformance import crashes
+from conformance import crash_journal
 from conformance import time_limit as limits
 from conformance.errors import SyncLoadError, SyncProtocolError, SyncRaised, SyncTimedOut
 from conformance.implementations import SHORT_NAMES
@@ -74,8 +74,8 @@ class SyncImplementation:
 
     def start(self, world: World) -> "Syncer":
         """Call the factory for ``world``; errors become :class:`~conformance.errors.SyncError`."""
-        crashes.check_not_crashed(self.spec, world.scene)
-        crashes.at(world.scene, None)
+        crash_journal.check_not_crashed(self.spec, world.scene)
+        crash_journal.at(world.scene, None)
         try:
             with limits.limited(self.time_limit):
                 step_fn = self.factory(world)
@@ -87,7 +87,7 @@ class SyncImplementation:
                 f"{_exception_line(exc)}{_user_location(exc)}."
             ) from exc
         finally:
-            crashes.returned()
+            crash_journal.returned()
         if not callable(step_fn):
             raise SyncProtocolError(
                 f"sync implementation {self.spec!r} returned {step_fn!r} (type {type(step_fn).__name__}) for scene "
@@ -114,7 +114,7 @@ class Syncer:
 
     def __call__(self, frame: int) -> None:
         self.frame = frame
-        crashes.at(self.scene, frame)
+        crash_journal.at(self.scene, frame)
         try:
             with limits.limited(self.time_limit):
                 self._fn()
@@ -126,7 +126,7 @@ class Syncer:
                 f"{_exception_line(exc)}{_user_location(exc)}."
             ) from exc
         finally:
-            crashes.returned()
+            crash_journal.returned()
 
 
 def _check_arity(fn: Any, n: int, what: str) -> None:
