@@ -10,7 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from conformance import backends, poses, shapes, truth
+from conformance import backends
+from conformance.bullet import poses, shapes, truth
 from conformance.backends.common import Drawing
 from conformance.tolerances import DEFAULT, Tolerance
 

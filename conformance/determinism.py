@@ -13,7 +13,8 @@ import subprocess
 import sys
 from typing import Any, Mapping
 
-from conformance import scenes, state
+from conformance import scenes
+from conformance.bullet import state
 
 __all__ = ["MAX_STEPS", "digest", "digests_in_subprocess", "first_divergence"]
 
@@ -61,7 +62,7 @@ def digests_in_subprocess(names: list[str], steps: int | None = None) -> dict[st
 
 
 def first_divergence(scene_name: str, steps: int, distance: float = 1e-9) -> int | None:
-    """The first step after which a run nudged by ``distance`` (:func:`conformance.state.nudged`) differs from the
+    """The first step after which a run nudged by ``distance`` (:func:`conformance.bullet.state.nudged`) differs from the
     plain run beyond the physics verdict's tolerance, or None within ``steps``: where a scene's
     physics turns chaotic, measured."""
     with scenes.build(scene_name) as plain, scenes.build(scene_name) as moved:

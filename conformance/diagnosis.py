@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 import pybullet
 
-from conformance import poses
+from conformance.bullet import poses
 
 __all__ = ["EULER_ORDERS", "MISTAKES", "NORMAL_MISTAKES", "Drawn", "diagnose", "diagnose_frame", "diagnose_normals",
            "diagnose_problems", "drawn_now", "explain", "explain_frame", "explain_normals", "unannounced"]

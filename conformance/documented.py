@@ -3,7 +3,7 @@ on the installed pybullet, as a table.
 
 Each :class:`Statement` quotes its document, says what that means in numbers, and measures it
 (in the kit's own scenes or a fresh client, always disconnected). Its verdict compares the
-measurement with the deviation list (``conformance.deviations``):
+measurement with the deviation list (``conformance.bullet.deviations``):
 
 * ``as documented``: pybullet does what the sentence says;
 * ``deviates (listed: id)``: it does not, and the deviation is listed for this pybullet — the
@@ -26,7 +26,8 @@ from typing import Callable
 
 import numpy as np
 
-from conformance import collisions, deviations, physics, scenes
+from conformance import scenes
+from conformance.bullet import collisions, deviations, physics
 from conformance.scenes import Shape
 from conformance.scenes.crossing import Timeline
 
@@ -328,7 +329,7 @@ def table() -> str:
                      f"{_cell(row.observed)} | {row.verdict} |")
     listed = [d for d in deviations.DEVIATIONS if d.applies(version)]
     if listed:
-        lines += ["", "Deviations listed for this pybullet (`conformance/deviations.py`), each an expected failure of "
+        lines += ["", "Deviations listed for this pybullet (`conformance/bullet/deviations.py`), each an expected failure of "
                       "the check named:", ""]
         for d in listed:
             lines.append(f"* `{d.id}` (pybullet {d.affected}) — {d.check}. Evidence: {'; '.join(d.evidence)}.")

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from conformance import figures
-from conformance.collisions import Outcome
+from conformance.bullet.collisions import Outcome
 
 __all__ = [
     "assert_close",

@@ -70,7 +70,7 @@ def reproduce_command(scene: str, sync: str, frames: int, params: Mapping[str, A
     if params:
         words += ["--params", json.dumps(dict(params), sort_keys=True)]
     if events:
-        from conformance import events as events_module
+        from conformance.bullet import events as events_module
 
         words += ["--events", events_module.dumps(events)]
     return shlex.join(words)

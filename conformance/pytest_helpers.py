@@ -18,7 +18,8 @@ from typing import Any, Callable, Iterable, Iterator, Mapping, Sequence
 
 import pytest
 
-from conformance import compare, diagnosis, events as events_module, figures, profiles, scenes, survey as survey_module
+from conformance import compare, diagnosis, figures, profiles, scenes, survey as survey_module
+from conformance.bullet import events as events_module
 from conformance.errors import SyncError
 from conformance.survey import WORST  # noqa: F401  (where the plugin and older callers find it)
 from conformance.printed import reproduce_command

@@ -1,7 +1,7 @@
 """Run a scene with a sync implementation: build, set up the sync, and advance frame by frame.
 
 The order of a frame is fixed: the events of that frame (teleports, joint resets, kicks; see
-:mod:`conformance.events`), the scene's own actions, ``p.stepSimulation()``, then the sync under
+:mod:`conformance.bullet.events`), the scene's own actions, ``p.stepSimulation()``, then the sync under
 test. Frame 0 is the sync called once right after set-up (after frame-0 events), before any step.
 """
 
@@ -12,11 +12,12 @@ from collections import defaultdict
 from dataclasses import dataclass, field
 from typing import Any, Iterator, Mapping, Sequence
 
-from conformance import backends, truth
+from conformance import backends
+from conformance.bullet import truth
 from conformance.backends.common import Drawing
-from conformance.client import NOT_THE_DEFAULT_CLIENT, decoy_client
+from conformance.bullet.client import NOT_THE_DEFAULT_CLIENT, decoy_client
 from conformance.errors import SyncRaised
-from conformance.events import Event
+from conformance.bullet.events import Event
 from conformance.scenes import Scene, build
 from conformance.sync import Syncer, SyncImplementation
 
@@ -116,7 +117,7 @@ class Run:
 def running(scene: str, implementation: SyncImplementation, events: Sequence[Event] = (), **params: Any) -> Iterator[Run]:
     """Build ``scene`` with ``params``, draw it, start the sync, apply frame-0 events and sync frame 0;
     always disconnect. The scene is never on pyBullet's default client 0 (an empty decoy holds it,
-    :func:`conformance.client.decoy_client`), so a sync that leaves out the scene's client fails here as
+    :func:`conformance.bullet.client.decoy_client`), so a sync that leaves out the scene's client fails here as
     in a user's program with more than one client, and its error says so."""
     client = -1
     with decoy_client():

@@ -29,7 +29,8 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from conformance import backends, compare, runner, truth
+from conformance import backends, compare, runner
+from conformance.bullet import truth
 from conformance.errors import SyncError
 from conformance.survey import times
 from conformance.tolerances import DEFAULT, Tolerance

@@ -11,7 +11,7 @@ import math
 import numpy as np
 from hypothesis import strategies as st
 
-from conformance.events import JointReset, Kick, Teleport
+from conformance.bullet.events import JointReset, Kick, Teleport
 
 __all__ = [
     "HARD_ORIENTATIONS",
@@ -217,7 +217,7 @@ def frictions(low: float = 0.3, high: float = 1.0) -> st.SearchStrategy[float]:
 def landing_steps(low: int = 60, high: int = 140) -> st.SearchStrategy[int]:
     """Drops that reach the plate exactly at the end of step n: the height is the integrator's own
     free-fall distance g·dt²·n(n+1)/2, so the impact is not split across a step (see
-    ``conformance.physics.landing_height``). 60..140 steps at 1/240 s are drops of 0.3..1.7 m."""
+    ``conformance.bullet.physics.landing_height``). 60..140 steps at 1/240 s are drops of 0.3..1.7 m."""
     return st.integers(low, high)
 
 

@@ -6,7 +6,7 @@ and watches what happens the two ways a filter cannot fool: the contact points
 keeps its free flight exactly and ends in swapped order; a pair that collides rebounds). Never
 ``getClosestPoints``, which ignores every filter (bullet3 #4376). Hypothesis draws shapes, sizes,
 masses, speeds, orientations, whether the second body is a base or a multibody's link, and the
-filter calls; ``conformance.collisions`` holds the rules and the observation.
+filter calls; ``conformance.bullet.collisions`` holds the rules and the observation.
 
 The last check runs the sync under test on a filtered pair: bodies physics lets pass through each
 other must be drawn overlapping, so a sync that hides a physics fault cannot pass.
@@ -18,7 +18,7 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 from conformance import compare, scenes
-from conformance.collisions import (
+from conformance.bullet.collisions import (
     FilterMode,
     GroupMask,
     PairFilter,
@@ -27,7 +27,7 @@ from conformance.collisions import (
     observe,
     pair_of,
 )
-from conformance.deviations import NO_SHRINK, expected_failure
+from conformance.bullet.deviations import NO_SHRINK, expected_failure
 from conformance.physics_assertions import (
     assert_collision,
     assert_drawn_overlapping,

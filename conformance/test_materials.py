@@ -14,8 +14,8 @@ import numpy as np
 from hypothesis import given, settings, strategies as st
 
 from conformance import scenes
-from conformance.deviations import NO_SHRINK, expected_failure
-from conformance.physics import (
+from conformance.bullet.deviations import NO_SHRINK, expected_failure
+from conformance.bullet.physics import (
     base_state,
     bounce_ratio,
     damped_step,

@@ -13,7 +13,7 @@ import pytest
 from hypothesis import given, strategies as st
 
 from conformance import backends, image_options, scenes, shared_run, strategies
-from conformance.events import Teleport
+from conformance.bullet.events import Teleport
 from conformance.profiles import check_settings
 from conformance.pytest_helpers import _context, each_scene
 from conformance.rendering import framing, golden, silhouettes

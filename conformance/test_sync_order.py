@@ -22,7 +22,7 @@ from hypothesis import settings, strategies as st
 from hypothesis.stateful import RuleBasedStateMachine, initialize, invariant, precondition, rule, run_state_machine_as_test
 
 from conformance import profiles, strategies, survey
-from conformance.events import JointReset, Kick, Teleport
+from conformance.bullet.events import JointReset, Kick, Teleport
 from conformance.profiles import check_settings, stateful_steps
 from conformance.pytest_helpers import VERTEX_TARGET, Kit, _context
 
@@ -111,7 +111,7 @@ def machine(kit: Kit, scene_name: str) -> type[RuleBasedStateMachine]:
             self.fresh = False
 
         def body(self, which: int) -> int:
-            """The body an event's ``which`` names (as :mod:`conformance.events` picks it)."""
+            """The body an event's ``which`` names (as :mod:`conformance.bullet.events` picks it)."""
             return self.bodies[which % len(self.bodies)]
 
         def synced(self) -> None:

@@ -1,6 +1,6 @@
 """Vertex conformance: after every frame, what FURY draws is where pybullet says each body is.
 
-Ground truth is the kit's own (``conformance.truth``): each target's geometry captured in its link
+Ground truth is the kit's own (``conformance.bullet.truth``): each target's geometry captured in its link
 frame when the actor was built, moved by pybullet's link-frame pose (base:
 ``getBasePositionAndOrientation`` with the inertial offset undone; link: ``getLinkState(...)[4:6]``
 with forward kinematics); read-back is what the renderer will draw (FURY 0.12: polydata points through
@@ -14,7 +14,7 @@ import pytest
 from hypothesis import example, given, strategies as st
 
 from conformance import backends, compare, figures, profiles, scenes, shared_run, strategies
-from conformance.events import turning_everything
+from conformance.bullet.events import turning_everything
 from conformance.profiles import check_settings
 from conformance.printed import rerun_check
 from conformance.pytest_helpers import _context, bounds_figure, each_scene
@@ -40,7 +40,7 @@ def check_run(kit, scene_name: str, params: dict, frames: int, events=()) -> Non
 
 
 def turned_everything(scene_name: str, params: dict, turns) -> list:
-    """:func:`conformance.events.turning_everything` for every body of the scene built with ``params``."""
+    """:func:`conformance.bullet.events.turning_everything` for every body of the scene built with ``params``."""
     with scenes.build(scene_name, **params) as probe:
         bodies = len({b.body for b in probe.bindings})
     return turning_everything(bodies, turns)

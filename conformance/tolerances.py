@@ -22,7 +22,7 @@ with 16 segments, so in the worst direction their vertices reach cos(π/16) = 98
 pybullet's box is exact for boxes, and for spheres at their centre of mass; for cylinders, and for
 shapes off the centre of mass (a compound), it is a box around a turned box, up to 1.3× the
 shape's size larger (measured over random turns); the kit predicts that looseness from pybullet's
-pose (:func:`conformance.truth.aabb_half_extents`) rather than allowing it everywhere.
+pose (:func:`conformance.bullet.truth.aabb_half_extents`) rather than allowing it everywhere.
 """
 
 from __future__ import annotations

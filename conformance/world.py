@@ -11,7 +11,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from conformance.client import BoundClient
+from conformance.bullet.client import BoundClient
 
 __all__ = ["Target", "World"]
 

@@ -15,7 +15,7 @@ from typing import Any, Callable, Mapping, Sequence
 import numpy as np
 import pybullet
 
-from conformance.client import BoundClient
+from conformance.bullet.client import BoundClient
 from conformance.errors import InvalidArgument, SceneError
 
 __all__ = [

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from conformance import determinism, scenes, state
+from conformance import determinism, scenes
+from conformance.bullet import state
 
 
 @pytest.mark.parametrize("scene_name", scenes.names())

@@ -8,7 +8,8 @@ from __future__ import annotations
 import pytest
 
 import wrong_syncs
-from conformance import compare, diagnosis, events, runner, sync
+from conformance import compare, diagnosis, runner, sync
+from conformance.bullet import events
 from right_syncs import PerTargetSync
 
 STATIC_MOVED = [events.Teleport(frame=3, which=0, offset=(0.0, 0.0, 0.5), orientation=(0.0, 0.0, 0.3826834, 0.9238795))]

@@ -10,12 +10,13 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 
-from conformance import collisions, deviations, documented, physics, strategies, sync
+from conformance import documented, strategies, sync
+from conformance.bullet import collisions, deviations, physics
 from conformance import test_filters as filters
 from conformance import test_forces as forces
 from conformance import test_materials as materials
-from conformance.collisions import FilterMode, GroupMask, PairFilter
-from conformance.physics import Push
+from conformance.bullet.collisions import FilterMode, GroupMask, PairFilter
+from conformance.bullet.physics import Push
 
 Failed = pytest.fail.Exception
 
@@ -281,7 +282,7 @@ def test_every_expected_failure_in_the_checks_is_listed():
                 if mark.name == "xfail":
                     reason = mark.kwargs["reason"]
                     assert any(d.id in reason and d.check.endswith(f"::{name}") for d in deviations.DEVIATIONS), (
-                        f"{module.__name__}.{name} is an expected failure not listed in conformance/deviations.py")
+                        f"{module.__name__}.{name} is an expected failure not listed in conformance/bullet/deviations.py")
 
 
 def test_deviations_are_keyed_by_version():
@@ -298,7 +299,7 @@ def test_deviations_are_keyed_by_version():
 def test_documented_table_agrees_with_the_deviation_list():
     measured = documented.rows()
     unexpected = [f"{r.statement.id}: {r.verdict} ({r.observed})" for r in measured if r.unexpected]
-    assert not unexpected, "documented vs observed disagrees with conformance/deviations.py:\n" + "\n".join(unexpected)
+    assert not unexpected, "documented vs observed disagrees with conformance/bullet/deviations.py:\n" + "\n".join(unexpected)
     listed = {r.statement.deviation for r in measured if r.statement.deviation}
     assert listed == {d.id for d in deviations.DEVIATIONS}, "every listed deviation needs a row in the table"
 
@@ -319,7 +320,7 @@ def test_table_is_markdown_with_a_row_per_statement():
 
 
 VANISHED = '''
-from conformance.deviations import expected_failure
+from conformance.bullet.deviations import expected_failure
 
 @expected_failure("default-collision-filter-mode", version="3.2.7")
 def test_behaves_as_documented():

@@ -157,7 +157,7 @@ def test_regen_keeps_goldens_whose_state_differs_only_by_float_noise(copy, monke
 def test_a_state_change_beyond_the_float_noise_bound_is_written(copy, monkeypatch, capsys, factor, status):
     """One target moved by half the bound is kept; by twice the bound, its manifest is written and
     the physics difference reported (the picture is the same)."""
-    from conformance import state
+    from conformance.bullet import state
 
     def moved(frame, image, made):
         made = json.loads(json.dumps(made))
@@ -211,7 +211,7 @@ def test_any_other_manifest_difference_is_written_with_the_noise(copy, monkeypat
 
 
 def test_float_noise_is_the_largest_float_difference_of_states_alike_in_all_else():
-    from conformance import state
+    from conformance.bullet import state
 
     old = {"bodies": [{"body": 1, "joints": [], "position": [0.25, -0.0, 3.0]}], "targets": [{"name": "box", "position": [1.0]}]}
     assert state.float_noise(old, old) == state.FloatNoise(0.0, "")
@@ -232,7 +232,7 @@ def test_float_noise_is_the_largest_float_difference_of_states_alike_in_all_else
     ("angular_velocity", 1e-4, True), ("angular_velocity", 1e-3, False),  # over one 1/240 s step
     ("linear_velocity", 1e-5, True), ("linear_velocity", 1e-4, False)])
 def test_each_float_counts_against_the_tolerance_of_what_it_is(field, change, noise):
-    from conformance import state
+    from conformance.bullet import state
 
     old = {"bodies": [{"body": 1, field: [0.5, 0.25, 0.125]}]}
     new = {"bodies": [{"body": 1, field: [0.5, 0.25 + change, 0.125]}]}

@@ -156,7 +156,7 @@ def test_which_of_two_touching_bodies_is_in_front_is_left_out_but_where_each_is_
 def test_touching_pairs_are_bodies_in_contact():
     """A cylinder sunk into the ground (the case the orientation property once failed a right sync on)
     is in contact with it; two spheres half a metre apart are not."""
-    from conformance import events
+    from conformance.bullet import events
     from conformance.pytest_helpers import sync_run
 
     turn = events.loads('[{"kind":"teleport","frame":0,"which":0,"offset":[0.0,0.0,0.0],'

@@ -1,4 +1,4 @@
-"""The kit's own reading of pybullet (``conformance.truth``) agrees with pybullet."""
+"""The kit's own reading of pybullet (``conformance.bullet.truth``) agrees with pybullet."""
 
 from __future__ import annotations
 
@@ -6,8 +6,9 @@ import numpy as np
 import pybullet
 from hypothesis import given, settings, strategies as st
 
-from conformance import strategies, truth
-from conformance.client import BoundClient
+from conformance import strategies
+from conformance.bullet import truth
+from conformance.bullet.client import BoundClient
 
 sizes = st.floats(0.05, 0.5)
 offsets = st.tuples(*[st.floats(-0.3, 0.3)] * 3)

@@ -15,7 +15,7 @@ from scipy.spatial.transform import Rotation
 
 from conformance import backends, compare, sync
 from conformance import test_vertices as checks
-from conformance.events import Teleport
+from conformance.bullet.events import Teleport
 from conformance.pytest_helpers import Kit
 from conformance.strategies import HARD_ORIENTATIONS
 from conformance.tolerances import DEFAULT

@@ -30,7 +30,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
-from conformance import poses
+from conformance.bullet import poses
 from conformance.tolerances import DEFAULT, Tolerance
 
 __all__ = ["Attachment", "VARIANTS", "attach", "local_coordinates", "variant_fit"]

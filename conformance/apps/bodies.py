@@ -4,7 +4,7 @@ An app is judged against *all* of its bodies, not a list it hands the kit: each 
 each body on each client the app connected is a frame that drawn vertices may follow. A frame's pose
 is its link frame (pybullet-facts.md, "Frames"): for a base, ``getBasePositionAndOrientation`` with the
 inertial offset of ``getDynamicsInfo(body, -1)[3:5]`` undone; for a link,
-``getLinkState(..., computeForwardKinematics=1)[4:6]`` (:func:`conformance.truth.link_frames`).
+``getLinkState(..., computeForwardKinematics=1)[4:6]`` (:func:`conformance.bullet.truth.link_frames`).
 
 A frame's collision shape is described in its link frame (``getCollisionShapeData`` gives it in the
 centre-of-mass frame, which is the link frame moved by the local inertial frame), so the kit can tell
@@ -18,8 +18,8 @@ from dataclasses import asdict, dataclass
 import numpy as np
 import pybullet
 
-from conformance import poses, truth
-from conformance.client import BoundClient
+from conformance.bullet import poses, truth
+from conformance.bullet.client import BoundClient
 
 __all__ = ["Frame", "frames_of", "read_poses", "read_velocities"]
 

@@ -2,7 +2,7 @@
 
 An app's bodies move only as its story goes: a wall that tips about one axis never shows that Euler
 angles applied in the wrong order turn a body about the wrong axes. Because the kit drives the app's
-loop, it can do to the app what it does to its scenes (:mod:`conformance.events`): before the app's
+loop, it can do to the app what it does to its scenes (:mod:`conformance.bullet.events`): before the app's
 callback of tick ``k``, turn a body to a hard orientation, kick it, or reset a joint, so that the app's
 sync has to draw poses its story never produces. Every event is applied on every pyBullet client of the
 app that has bodies (an app may keep an empty client, or one per world). Events name bodies by position
@@ -22,7 +22,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from types import SimpleNamespace
 
-from conformance import events as scene_events
+from conformance.bullet import events as scene_events
 from conformance.apps.bodies import Frame
 
 __all__ = ["AfterStep", "apply", "apply_after_step", "as_dict", "from_dicts"]
@@ -40,7 +40,7 @@ class AfterStep:
 
 
 def _scene(client: int, frames: list[Frame], dynamic: bool):
-    from conformance.client import BoundClient
+    from conformance.bullet.client import BoundClient
 
     p = BoundClient(client)
     wanted = sorted({f.body for f in frames if f.client == client and f.link == -1 and f.node < 0 and (f.mass > 0 or not dynamic)})

@@ -24,7 +24,7 @@ def opening() -> list:
     """The first perturbed run's events: every way of turning a body the kit has, early in the run, and
     one body turned between the step and the sync of tick 4, so that the sync sees it at rest."""
     from conformance.apps.perturb import AfterStep
-    from conformance.events import JointReset, Kick, Teleport
+    from conformance.bullet.events import JointReset, Kick, Teleport
 
     hard = strategies.HARD_ORIENTATIONS
     # a half turn about (1, 1, 1); then, written with negative w, pitch +90°, pitch near -90°, pitch -90°

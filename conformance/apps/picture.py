@@ -124,7 +124,7 @@ def take(source, tracks, frames, clients, tick: int) -> dict:
     per pixel (-1 none), ``faint`` and ``stale`` (one bool per app-wide vertex: drawn fainter than
     :data:`FAINT`; held by the GPU elsewhere than its array), ``hidden`` (per actor), ``touching``,
     ``notes``; or only ``tick`` and ``skipped`` (why no picture was taken)."""
-    from conformance.client import BoundClient
+    from conformance.bullet.client import BoundClient
     from conformance.rendering import silhouettes
 
     viewed = getattr(source, "camera", None)

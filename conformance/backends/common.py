@@ -12,7 +12,7 @@ from typing import Any, Callable, Iterator
 
 import numpy as np
 
-from conformance import poses, truth
+from conformance.bullet import poses, truth
 from conformance.errors import SceneError
 from conformance.world import Target, World
 

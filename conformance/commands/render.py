@@ -79,7 +79,8 @@ def run(args, extra) -> int:
 
 def _validated(args) -> _Request:
     """Every argument checked, before the display starts or anything is written."""
-    from conformance import animation, events, scenes, sync
+    from conformance import animation, scenes, sync
+    from conformance.bullet import events
 
     names = scenes.names() if args.scene == ["all"] else args.scene
     request = _Request(names=names, specs={name: scenes.get(name) for name in names})  # unknown names refused here

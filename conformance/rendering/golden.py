@@ -2,7 +2,7 @@
 
 Layout: ``<golden dir>/<scene>/frame-<NNNN>.png`` and ``frame-<NNNN>.json`` beside it. The manifest
 says how the picture was made (scene, parameters, frame, camera, size, sync, the renderer's OpenGL
-strings, library versions) and holds the physics state of that frame (:mod:`conformance.state`).
+strings, library versions) and holds the physics state of that frame (:mod:`conformance.bullet.state`).
 
 Guarantees:
 

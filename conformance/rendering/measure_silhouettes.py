@@ -31,7 +31,7 @@ def measure(scene_names, draws: int, seed: int = 0, keep=None) -> list[dict]:
     from hypothesis import seed as seeded
 
     from conformance import backends, runner, scenes, strategies, sync
-    from conformance.events import turning_everything
+    from conformance.bullet.events import turning_everything
     from conformance.rendering import silhouettes
 
     reference = sync.load("reference")

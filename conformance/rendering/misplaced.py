@@ -45,7 +45,7 @@ def note(node, run, failures: Sequence[Any], worst, *, sync: str, message: str, 
     only the first failure of the check (survey mode)."""
     if node is None or (first and PICTURE in node.stash) or not _final_example():
         return
-    from conformance import events as events_module
+    from conformance.bullet import events as events_module
     from conformance.printed import reproduce_command
     from conformance.rendering import golden, outline
 

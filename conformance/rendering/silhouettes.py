@@ -318,7 +318,7 @@ def thresholds(bindings: Sequence) -> list[float]:
 def projected_discs(scene, bindings: Sequence, camera, size) -> list[tuple[float, float, float] | None]:
     """Where each sphere binding is on screen now, as physics has it: ``(column, row, radius)`` in pixels
     (its centre projected, its radius at its depth); None for other shapes and a sphere behind the camera."""
-    from conformance import poses, truth
+    from conformance.bullet import poses, truth
 
     spheres = [i for i, b in enumerate(bindings) if b.shape.kind == "sphere"]
     found: list[tuple[float, float, float] | None] = [None] * len(bindings)
@@ -338,7 +338,7 @@ def projected_discs(scene, bindings: Sequence, camera, size) -> list[tuple[float
 def projected_radii(scene, bindings: Sequence, camera, size) -> list[float | None]:
     """Each cylinder binding's radius on screen in pixels at its centre's depth (what scales its rim's
     slack, :data:`ROUNDING`); None for other shapes (a sphere's is in :func:`projected_discs`)."""
-    from conformance import poses, truth
+    from conformance.bullet import poses, truth
 
     cylinders = [i for i, b in enumerate(bindings) if b.shape.kind == "cylinder"]
     found: list[float | None] = [None] * len(bindings)

@@ -14,7 +14,7 @@
   with the stored one: a difference there is pyBullet or the platform, not rendering;
 * :func:`regenerate` writes goldens anew (atomically, unchanged bytes untouched) and says what
   changed and by how much; a golden whose picture is the same and whose state differs only by float
-  noise (:data:`conformance.state.NOISE_SHARE` of the physics tolerance) is kept as it is, so another CPU regenerates no noise.
+  noise (:data:`conformance.bullet.state.NOISE_SHARE` of the physics tolerance) is kept as it is, so another CPU regenerates no noise.
 """
 
 from __future__ import annotations
@@ -26,7 +26,8 @@ from typing import Any
 
 import numpy as np
 
-from conformance import backends, state
+from conformance import backends
+from conformance.bullet import state
 from conformance.errors import GoldenError, GoldenFramesBadly
 from conformance.rendering import framing
 from conformance.rendering import golden as storage

@@ -60,7 +60,7 @@ class Deviation:
                 f"{', '.join(self.measured_on)}): the {self.document} says \"{self.quote}\" — documented: "
                 f"{self.documented}; observed: {self.observed}. Evidence: {'; '.join(self.evidence)}. "
                 "If this check passes, pybullet now behaves as documented: narrow the range in "
-                "conformance/deviations.py.")
+                "conformance/bullet/deviations.py.")
 
 
 DEVIATIONS: tuple[Deviation, ...] = (

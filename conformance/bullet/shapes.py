@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pybullet
 
-from conformance import poses
+from conformance.bullet import poses
 
 __all__ = ["compose", "kind_name", "problems", "to_frame"]
 

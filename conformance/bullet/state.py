@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from conformance import truth
+from conformance.bullet import truth
 
 __all__ = ["FLOAT_NOISE", "NOISE_SHARE", "NOISE_STEP", "FloatNoise", "PhysicsDifference", "capture", "compare", "float_noise",
            "nudged", "restore"]

@@ -23,8 +23,8 @@ import numpy as np
 import pybullet
 from scipy.spatial.transform import Rotation
 
-from conformance import poses
-from conformance.client import BoundClient
+from conformance.bullet import poses
+from conformance.bullet.client import BoundClient
 
 __all__ = ["aabb_half_extents", "expected_vertices", "frames_of", "link_frame", "link_frames", "read_states"]
 

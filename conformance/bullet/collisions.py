@@ -15,7 +15,7 @@ from typing import Any, Iterable, Sequence
 
 import numpy as np
 
-from conformance.client import BoundClient
+from conformance.bullet.client import BoundClient
 
 __all__ = [
     "AND_MODE",

@@ -21,7 +21,7 @@ import numpy as np
 import pybullet
 from scipy.spatial.transform import Rotation
 
-from conformance.client import BoundClient
+from conformance.bullet.client import BoundClient
 
 __all__ = [
     "BaseState",

@@ -86,7 +86,7 @@ class Kick:
     spin: tuple[float, float, float]
 
     def apply(self, scene) -> None:
-        from conformance import poses
+        from conformance.bullet import poses
 
         bodies = _bodies(scene)
         body = bodies[self.which % len(bodies)]
