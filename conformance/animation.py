@@ -219,7 +219,7 @@ def record(scene: str, implementation, frames: range, out: Path, *, size: tuple[
            events: Iterable[Any] = (), params: dict | None = None, show_progress: bool = True,
            tolerance=None) -> Animation:
     """Run ``scene`` with ``implementation`` (a loaded sync), check and render each frame of ``frames``,
-    and write the animation to ``out``. Needs a display (:func:`conformance.display.ensure_display`)."""
+    and write the animation to ``out``. Needs a display (:func:`conformance.backends.display.ensure_display`)."""
     from conformance import backends, files, runner
     from conformance.progress import progress
     from conformance.rendering import outline

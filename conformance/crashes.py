@@ -21,7 +21,7 @@ and the process that started pytest survives to give the verdict. What is guaran
   naming the crash, instead of crashing another worker (:class:`~conformance.errors.SyncCrashed`): so
   a sync that crashes everywhere costs one worker start per scene (under ``-n``, one per worker that was
   already running one of that scene's checks), and xdist's limit on restarts is raised to cover every scene.
-* Nothing is left behind: a worker's Xvfb dies with it (:mod:`conformance.display`), and the crash files
+* Nothing is left behind: a worker's Xvfb dies with it (:mod:`conformance.backends.display`), and the crash files
   live in a temporary directory the controller removes at the end.
 """
 

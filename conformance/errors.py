@@ -53,7 +53,7 @@ class BackendError(ConformanceError):
 
 class DisplayUnavailable(ConformanceError):
     """No X display is set and none could be started for off-screen rendering, the X server refuses
-    connections, or VTK's OpenGL driver cannot start on it (:mod:`conformance.renderer_start`)."""
+    connections, or VTK's OpenGL driver cannot start on it (:mod:`conformance.backends.renderer_start`)."""
 
 
 class SyncError(ConformanceError):

@@ -276,7 +276,7 @@ def pytest_runtest_logstart(nodeid: str, location) -> None:
 
 
 def pytest_unconfigure(config: pytest.Config) -> None:
-    from conformance.display import stop_display
+    from conformance.backends.display import stop_display
 
     stop_display()
 

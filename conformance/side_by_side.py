@@ -218,7 +218,7 @@ def compare_scene(scene: str, a, b, *, frames: int, params: Mapping[str, Any] | 
     ``scene`` in lockstep for frames 0..``frames`` and compare them at every frame. With
     ``image_frame``, also render both at that frame and compare the pictures within
     ``image_tolerance`` (default: same-renderer, since both are rendered here); call it inside
-    :func:`conformance.display.virtual_display`."""
+    :func:`conformance.backends.display.virtual_display`."""
     params = dict(params or {})
     result = SceneComparison(scene=scene, specs=(a.spec, b.spec), params=params, frames=frames, image_frame=image_frame)
     try:

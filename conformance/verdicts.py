@@ -107,7 +107,7 @@ def check(spec: str, *, stop_at_first: bool = False, survey: bool = False, pytes
         report = os.path.join(tmp, "report.json")
         argv = command(spec, stop_at_first=stop_at_first, survey=survey, pytest_args=list(pytest_args), report=report,
                        results=os.path.join(tmp, "results"))
-        from conformance.display import child_environment, dies_with_this_process
+        from conformance.backends.display import child_environment, dies_with_this_process
 
         try:
             proc = subprocess.run(argv, capture_output=True, text=True, env=child_environment(env), timeout=timeout,

@@ -13,7 +13,7 @@ import sys
 from pathlib import Path
 
 import conformance
-from conformance import display
+from conformance.backends import display
 
 __all__ = ["environment", "run", "said"]
 
@@ -21,7 +21,7 @@ __all__ = ["environment", "run", "said"]
 def environment(**variables) -> dict[str, str]:
     """This process's environment for a child of the kit's, with every driver variable replaced by
     ``variables``, and this checkout's ``conformance`` first on the path (a worktree's, not an install's)."""
-    from conformance import renderer_start as rs
+    from conformance.backends import renderer_start as rs
 
     dropped = set(rs.GL_VARIABLES + rs.WGPU_VARIABLES) | {rs.PROBED_VARIABLE, "PYTHONFAULTHANDLER"}
     env = {k: v for k, v in display.child_environment().items() if k not in dropped}

@@ -18,7 +18,8 @@ from pathlib import Path
 
 import pytest
 
-from conformance import backends, display
+from conformance import backends
+from conformance.backends import display
 
 pytestmark = [
     pytest.mark.skipif(not sys.platform.startswith("linux") or display.shutil.which("Xvfb") is None,
@@ -119,7 +120,8 @@ def _kill(process: subprocess.Popen, signum: int) -> int:
 #: Renders a picture (so an X connection is open, as in a real run), says its Xvfb, then waits.
 RENDER_AND_WAIT = """
 import os, time
-from conformance import backends, display, runner, sync
+from conformance import backends, runner, sync
+from conformance.backends import display
 with runner.running("free_fall", sync.load("reference")) as run:
     backends.render(run.drawing, run.scene.camera, (64, 48))
     print("xvfb", display.server_pid(), os.environ["DISPLAY"], flush=True)

@@ -9,7 +9,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from conformance.display import child_environment
+from conformance.backends.display import child_environment
 
 TESTS = Path(__file__).resolve().parent
 

@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 
 from conformance import backends, cli
-from conformance.display import child_environment, dies_with_this_process
+from conformance.backends.display import child_environment, dies_with_this_process
 
 DOCS = Path(__file__).resolve().parent.parent / "docs" / "own-scenes.md"
 TESTS = Path(__file__).resolve().parent

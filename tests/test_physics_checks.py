@@ -348,7 +348,7 @@ def test_an_expected_failure_offers_no_patch_to_the_kit_s_own_files(tmp_path):
     import subprocess
     import sys
 
-    from conformance.display import child_environment
+    from conformance.backends.display import child_environment
 
     run = subprocess.run([sys.executable, "-m", "pytest", "--pyargs", "conformance", "-p", "no:cacheprovider",
                           "-k", "test_default_filter_mode_is_and"], cwd=tmp_path, capture_output=True, text=True,

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import background
 from conformance import backends
-from conformance.display import child_environment, dies_with_this_process
+from conformance.backends.display import child_environment, dies_with_this_process
 
 ROOT = Path(__file__).resolve().parent.parent
 MODULE, PAGE = {"vtk": ("my_sync", ROOT / "docs" / "backends.md"), "pygfx": ("my_sync_fury2", ROOT / "README.md")}[backends.NAME]

@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from conformance import backends, cli, display, images
+from conformance import backends, cli, images
+from conformance.backends import display
 from conformance.errors import DisplayUnavailable
 from children import run as _run, said as _said
 
@@ -130,7 +131,7 @@ def test_xvfb_that_fails_to_start_is_a_clear_error(monkeypatch):
     assert "DISPLAY" not in __import__("os").environ and display._started is None
 
 
-# -- a renderer that cannot start (conformance/renderer_start.py) ---------------------------------------
+# -- a renderer that cannot start (conformance/backends/renderer_start.py) ---------------------------------------
 
 #: Per backend: an environment its renderer cannot start in, and what the kit's paragraph must say.
 BROKEN = {
@@ -197,7 +198,7 @@ def _child(tmp_path, code: str, **variables) -> str:
 def test_an_opengl_older_than_3_2_is_refused_too(tmp_path):
     """VTK neither aborts nor draws here: it logs an error and goes on."""
     said = _child(tmp_path, """
-        from conformance import display, renderer_start
+        from conformance.backends import display, renderer_start
         from conformance.errors import DisplayUnavailable
         display.ensure_display()
         try:
@@ -213,7 +214,7 @@ def test_an_opengl_older_than_3_2_is_refused_too(tmp_path):
 def test_the_probe_runs_once_per_process_and_environment(tmp_path):
     assert _child(tmp_path, """
         import os
-        from conformance import renderer_start
+        from conformance.backends import renderer_start
         from conformance.errors import DisplayUnavailable
 
         answers, probes = iter([None, "the paragraph"]), []
@@ -238,7 +239,7 @@ def test_the_probe_runs_once_per_process_and_environment(tmp_path):
 
 
 def test_what_the_child_said_is_one_line_without_vtks_log_prefix():
-    from conformance.renderer_start import last_words
+    from conformance.backends.renderer_start import last_words
 
     stderr = ("pybullet build time: Jan 29 2025 23:17:20\nlibGL error: failed to load driver: swrast\n"
               "\x1b[0m\x1b[31m2026-11-25 15:20:18.086 (   0.183s) [    7FD697A1DB80]vtkXOpenGLRenderWindow.:651    ERR| "

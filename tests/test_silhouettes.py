@@ -12,7 +12,8 @@ import pybullet
 import pytest
 
 from conformance import backends, runner, scenes, sync
-from conformance.rendering import framing, projection, silhouettes
+from conformance.rendering import framing, silhouettes
+from conformance.backends import projection
 
 REFERENCE = sync.load("reference")
 

@@ -51,9 +51,9 @@ def main(argv=None) -> int:
 
     name = backends.NAME
     if name == "vtk":
-        from conformance.display import ensure_display
+        from conformance.backends.display import ensure_display
         from conformance.errors import DisplayUnavailable
-        from conformance.renderer_start import check_gl
+        from conformance.backends.renderer_start import check_gl
 
         ensure_display()
         try:

@@ -50,7 +50,7 @@ PICTURES = 4
 
 @dataclass(frozen=True)
 class Camera:
-    """A perspective camera as :mod:`conformance.rendering.projection` takes it (vertical view angle, degrees)."""
+    """A perspective camera as :mod:`conformance.backends.projection` takes it (vertical view angle, degrees)."""
 
     position: tuple
     focal_point: tuple
@@ -81,7 +81,7 @@ def picture_size(app_size) -> tuple[int, int]:
 def clipping_range(camera: Camera, points: np.ndarray) -> tuple[float, float]:
     """Near and far planes around ``points`` (n, 3) seen from ``camera``: 10 % beyond the farthest, and
     the nearest in front of the camera (at least 1/1000 of the far plane, a usable depth resolution)."""
-    from conformance.rendering import projection
+    from conformance.backends import projection
 
     view = projection.view_matrix(camera)
     depth = -(points @ view[2, :3] + view[2, 3]) if len(points) else np.array([1.0])

@@ -191,7 +191,7 @@ def _rounds(shot: dict, recording, rounding) -> tuple[list, list]:
     in pixels: :func:`conformance.rendering.silhouettes.projected_discs`, from the recorded poses), and each
     cylinder frame's radius on screen (:func:`~conformance.rendering.silhouettes.projected_radii`)."""
     from conformance.apps.picture import Camera
-    from conformance.rendering import projection
+    from conformance.backends import projection
 
     rounded = [i for i, kind in enumerate(rounding) if kind is not None]
     discs, radii = [None] * len(recording.frames), [None] * len(recording.frames)

@@ -24,6 +24,10 @@ one of them). The rest of the kit talks to a backend only through these names:
 * ``ANNOUNCE``: what tells the renderer that vertex data changed, for failure messages;
 * ``LIGHTING``: how every picture is lit, in words, for the golden manifests;
 * ``MULTISAMPLES``: the anti-aliasing every picture is made with unless asked otherwise.
+
+Beside the two backends live what every picture needs whatever draws it: ``projection`` (the camera as
+matrices), ``display`` (the virtual X display VTK needs, started once and never leaked) and
+``renderer_start`` (whether VTK's OpenGL driver can start, asked of a child process first).
 """
 
 from __future__ import annotations

@@ -26,7 +26,7 @@ import numpy as np
 
 from conformance.backends.common import Drawing, decode_ids, id_codes, lay_out, moved_range, transformed, turned_normals
 from conformance.errors import BackendError
-from conformance.renderer_start import WGPU_VARIABLES, asked_for, set_among
+from conformance.backends.renderer_start import WGPU_VARIABLES, asked_for, set_among
 
 __all__ = ["ANNOUNCE", "LIGHTING", "MULTISAMPLES", "NAME", "Drawing", "build", "content_state", "content_time", "flush", "hand_over", "mesh_signature", "perturbed", "render", "render_ids",
            "renderer_info", "world_normals", "world_vertices"]
@@ -400,10 +400,10 @@ def _stage(drawing: Drawing) -> _Stage:
 
 def _set_camera(camera, spec, size: tuple[int, int]) -> None:
     """Give the pygfx ``camera`` the scene camera ``spec`` exactly: its world matrix is the inverse of
-    :func:`conformance.rendering.projection.view_matrix`, and its frustum the vertical view angle
+    :func:`conformance.backends.projection.view_matrix`, and its frustum the vertical view angle
     ``spec.view_angle`` at aspect width/height. pygfx spreads ``fov`` over the mean of width and
     height (``height = 2·size/(1 + aspect)``), hence the conversion."""
-    from conformance.rendering import projection
+    from conformance.backends import projection
 
     width, height = size
     aspect = width / height

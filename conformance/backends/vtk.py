@@ -15,9 +15,9 @@ import numpy as np
 from vtkmodules.util import numpy_support
 
 from conformance.backends.common import Drawing, decode_ids, id_codes, lay_out, moved_range, transformed, turned_normals
-from conformance.display import close_x_connection, ensure_display, on_stop, x_connection
+from conformance.backends.display import close_x_connection, ensure_display, on_stop, x_connection
 from conformance.errors import DisplayUnavailable, SceneError
-from conformance.renderer_start import check_gl
+from conformance.backends.renderer_start import check_gl
 
 __all__ = ["ANNOUNCE", "LIGHTING", "MULTISAMPLES", "NAME", "Drawing", "build", "content_state", "content_time", "flush", "hand_over", "mesh_signature", "perturbed", "render", "render_ids", "renderer_info", "world_normals", "world_vertices"]
 
@@ -208,8 +208,8 @@ _connection = None  # the X connection it renders through (VTK does not close on
 def _render_window():
     """The process's off-screen render window, made once and reused for every picture. VTK 9.3 calls
     ``abort()`` when its own ``XOpenDisplay`` fails, so the window is handed a connection that
-    :func:`conformance.display.x_connection` opened with retries; and when it cannot make an OpenGL
-    context, so a child process tries first (:func:`conformance.renderer_start.check_gl`), and a
+    :func:`conformance.backends.display.x_connection` opened with retries; and when it cannot make an OpenGL
+    context, so a child process tries first (:func:`conformance.backends.renderer_start.check_gl`), and a
     driver that cannot start is a :class:`~conformance.errors.DisplayUnavailable`, not an abort."""
     global _window, _connection
     if _window is None:

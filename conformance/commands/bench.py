@@ -58,7 +58,7 @@ def add_arguments(parser) -> None:
 
 def run(args, extra) -> int:
     from conformance.commands.common import replace_block
-    from conformance.display import virtual_display
+    from conformance.backends.display import virtual_display
     from conformance.files import write_atomically
 
     benchmarks()

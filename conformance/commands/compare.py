@@ -121,7 +121,7 @@ def run(args, extra) -> int:
               "is not deterministic.\n")
     display = contextlib.nullcontext()
     if image is not None:
-        from conformance.display import virtual_display
+        from conformance.backends.display import virtual_display
 
         display = virtual_display()
     results = []

@@ -25,7 +25,7 @@ def add_arguments(parser) -> None:
 
 def run(args, extra) -> int:
     from conformance import own_scenes, scenes
-    from conformance.display import virtual_display
+    from conformance.backends.display import virtual_display
     from conformance.progress import progress
     from conformance.rendering import snapshots
 

@@ -67,7 +67,7 @@ class _Request:
 
 def run(args, extra) -> int:
     request = _validated(args)
-    from conformance.display import virtual_display
+    from conformance.backends.display import virtual_display
 
     with virtual_display():
         if request.gif is not None:

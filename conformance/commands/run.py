@@ -29,7 +29,7 @@ def run(args, extra: list[str]) -> int:
     # rewrite its asserts. The plug-in starts (and stops) a virtual display if it needs one, and
     # checks the other options (pytest's own usage errors exit with status 4).
     argv = [sys.executable, "-m", "pytest", "--pyargs", "conformance", "-p", "no:cacheprovider", *given, *extra]
-    from conformance.display import dies_with_this_process
+    from conformance.backends.display import dies_with_this_process
 
     # However this process ends (SIGTERM from a cancelled CI job, SIGKILL, Ctrl-C), pytest gets
     # SIGTERM and stops its display on the way out: nothing is left running.

@@ -14,8 +14,8 @@ from __future__ import annotations
 from typing import Collection
 
 
-from . import projection
-from .records import ImageCheck
+from conformance.backends import projection
+from conformance.rendering.records import ImageCheck
 
 __all__ = ["EXCEPTIONS", "MIN_EXTENT", "framing", "of_scene"]
 

@@ -109,7 +109,8 @@ def markdown(rows: list[dict], *, made_by: str, backend: str) -> str:
 
 
 def main(argv=None) -> int:
-    from conformance import backends, display, scenes
+    from conformance import backends, scenes
+    from conformance.backends import display
     from conformance.commands.common import emit
 
     parser = argparse.ArgumentParser(prog="python -m conformance.rendering.measure_silhouettes", description=__doc__.split("\n\n")[0])

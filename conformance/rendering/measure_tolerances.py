@@ -262,7 +262,7 @@ def _timing() -> float:
 
 def main(argv=None) -> int:
     from conformance import scenes
-    from conformance.display import virtual_display
+    from conformance.backends.display import virtual_display
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scenes", default=",".join(scenes.names()))

@@ -19,7 +19,7 @@ from typing import Any, Sequence
 
 import pytest
 
-from .records import ImageCheck
+from conformance.rendering.records import ImageCheck
 
 __all__ = ["PICTURE", "keep", "note"]
 

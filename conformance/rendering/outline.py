@@ -19,7 +19,7 @@ from typing import Iterable
 import numpy as np
 from scipy import ndimage
 
-from .silhouettes import pybullet_mask
+from conformance.rendering.silhouettes import pybullet_mask
 
 __all__ = ["OUTLINE_COLOUR", "WIDTH", "draw", "edges", "expected_outline", "outlined"]
 
@@ -63,7 +63,7 @@ def draw(picture: np.ndarray, outline: np.ndarray, colour=OUTLINE_COLOUR) -> np.
 
 def outlined(run, names: Iterable[str], size: tuple[int, int] | None = None) -> np.ndarray:
     """The sync's drawing of ``run`` now, rendered from the scene's camera at ``size``, with the expected
-    outline of the targets ``names`` over it. Needs a display (:func:`conformance.display.ensure_display`)."""
+    outline of the targets ``names`` over it. Needs a display (:func:`conformance.backends.display.ensure_display`)."""
     from conformance import backends
 
     size = tuple(size) if size else tuple(run.scene.image_size)

@@ -47,8 +47,8 @@ from scipy import ndimage
 
 from conformance import figures
 
-from . import projection
-from .records import ImageCheck
+from conformance.backends import projection
+from conformance.rendering.records import ImageCheck
 
 __all__ = ["LEAST_OFF", "MIN_IOU", "MIN_PIXELS", "ROUNDING", "SLACK", "TOUCHING", "compare_silhouettes", "mask_images",
            "projected_discs", "projected_radii", "pybullet_mask", "rounded_slacks", "roundings", "silhouette_check", "silhouette_record", "thresholds",

@@ -22,7 +22,7 @@ What is guaranteed:
 Cost, once per process: 202–229 ms (median 209 ms, 8 runs, load average 3.5 on this project's 2 cores,
 Mesa llvmpipe under Xvfb; up to 360 ms at load 4.6), about half of it importing VTK in the child and
 half making the context; a repeated call for the same environment 0.08 ms. Measured with
-``python -c "import time; from conformance import display, renderer_start as r; display.ensure_display();
+``python -c "import time; from conformance.backends import display, renderer_start as r; display.ensure_display();
 t = time.perf_counter(); r.check_gl(); print(time.perf_counter() - t)"`` (docs/numbers.md). A
 whole check takes seconds.
 
@@ -57,7 +57,7 @@ PROBE_TIMEOUT = 60.0
 #: Where a pass is left for child processes: a digest of the display and the variables it held for.
 PROBED_VARIABLE = "CONFORMANCE_GL_PROBED"
 
-# The child opens its own X connection with retries, as the kit does (conformance.display.x_connection),
+# The child opens its own X connection with retries, as the kit does (conformance.backends.display.x_connection),
 # so that a server slow to accept a connection is not taken for a driver that cannot start.
 _GL_PROGRAM = r"""
 import ctypes, ctypes.util, os, sys, time
@@ -93,7 +93,7 @@ def _digest(environ) -> str:
 
 def check_gl() -> None:
     """Return if VTK can make an OpenGL context on ``$DISPLAY`` (which must be set: call
-    :func:`conformance.display.ensure_display` first) in this environment; else raise
+    :func:`conformance.backends.display.ensure_display` first) in this environment; else raise
     :class:`DisplayUnavailable`. Probes at most once per process and environment."""
     key = _digest(os.environ)
     if key not in _answers and os.environ.get(PROBED_VARIABLE) == key:
@@ -108,7 +108,7 @@ def check_gl() -> None:
 
 def _probe() -> str | None:
     """Run the child; ``None`` if it drew, else the paragraph saying what failed and what to try."""
-    from conformance.display import dies_with_this_process
+    from conformance.backends.display import dies_with_this_process
 
     env = dict(os.environ)
     env.pop("PYTHONFAULTHANDLER", None)  # its stack dump would bury what the driver said
