@@ -54,7 +54,7 @@ def apps(backend: str) -> list[tuple[str, Path, dict]]:
 
 def measure(name: str, script: Path, environment: dict, *, repeats: int, ticks: int = TICKS) -> AppFigure:
     from conformance.apps import CHECKS, judge, launch
-    from conformance.tolerances import DEFAULT
+    from conformance.judge.tolerances import DEFAULT
 
     best = None
     for _ in range(repeats):

@@ -8,7 +8,7 @@ a run. ``stepSimulation()`` itself is timed in the same rounds, for scale.
 
 A figure is seconds per frame (best of the rounds); its ratio is to the floor's (:mod:`.floor`) for
 the same size and style. After timing, every candidate syncs one more frame and is judged by the
-kit's own vertex check (``conformance.compare.compare_vertices``), so a sync cannot look fast by
+kit's own vertex check (``conformance.judge.compare.compare_vertices``), so a sync cannot look fast by
 skipping work without the table saying it draws wrong.
 """
 
@@ -16,7 +16,8 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass
 
-from conformance import backends, compare, sync
+from conformance import backends, sync
+from conformance.judge import compare
 
 from . import grid
 from .floor import Floor

@@ -74,7 +74,7 @@ def _ratio(error: float, tolerance: float) -> float:
 def check_frame(run, frame: int, tolerance=None) -> FrameCheck:
     """Check ``run`` (a :class:`conformance.runner.Run`) as it stands at ``frame`` (to ``tolerance``, by
     default the kit's)."""
-    from conformance import compare
+    from conformance.judge import compare
 
     tolerance = tolerance or compare.DEFAULT
     vertices = compare.compare_vertices(run.drawing, frame, tolerance)

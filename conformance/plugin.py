@@ -10,7 +10,7 @@ Options live under one group, each mirrored by an ini setting:
   one worker process, so that a sync that crashes the interpreter fails its checks (:mod:`conformance.crashes`).
 * ``--conformance-size-rtol``, ``--conformance-position-rtol``, ``--conformance-atol``,
   ``--conformance-normal-angle`` (and ``conformance_size_rtol`` … in the ini file): the tolerances
-  of :mod:`conformance.tolerances`.
+  of :mod:`conformance.judge.tolerances`.
 * ``--conformance-report PATH`` / ``conformance_report``: write every check's outcome, scene and
   worst measured error as JSON (what ``python -m conformance verdicts`` reads).
 * Pictures (:mod:`conformance.image_options` reads and validates them):
@@ -122,7 +122,7 @@ def _option(config: pytest.Config, name: str):
 
 
 def tolerance_from(config: pytest.Config):
-    from conformance.tolerances import DEFAULT
+    from conformance.judge.tolerances import DEFAULT
 
     values = {name: value for name in _TOLERANCE_OPTIONS if (value := _option(config, name)) is not None}
     return dataclasses.replace(DEFAULT, **values)

@@ -43,7 +43,7 @@ def pytest() -> list[str]:
 
 def tolerance_arguments(tolerance) -> list[str]:
     """The ``--conformance-…`` options that give ``tolerance`` where it is not the kit's default."""
-    from conformance.tolerances import DEFAULT
+    from conformance.judge.tolerances import DEFAULT
 
     fields = ("size_rtol", "position_rtol", "atol", "normal_angle")
     return [w for name in fields if tolerance is not None and getattr(tolerance, name) != getattr(DEFAULT, name)

@@ -18,12 +18,13 @@ from typing import Any, Callable, Iterable, Iterator, Mapping, Sequence
 
 import pytest
 
-from conformance import compare, diagnosis, figures, profiles, scenes, survey as survey_module
+from conformance import figures, profiles, scenes, survey as survey_module
+from conformance.judge import compare, diagnosis
 from conformance.bullet import events as events_module
 from conformance.errors import SyncError
 from conformance.survey import WORST  # noqa: F401  (where the plugin and older callers find it)
 from conformance.printed import reproduce_command
-from conformance.tolerances import Tolerance
+from conformance.judge.tolerances import Tolerance
 
 #: The label of the vertex checks' ``hypothesis.target``: the worst vertex error over its tolerance.
 VERTEX_TARGET = "worst vertex error / tolerance"
@@ -323,6 +324,6 @@ class Kit:
 
 def bounds_figure(problems: Sequence[str]) -> dict[str, Any]:
     """The worst of a target's bounds problems as figure numbers (value, limit, unit), read from the
-    problems :func:`conformance.compare.compare_bounds` states."""
+    problems :func:`conformance.judge.compare.compare_bounds` states."""
     fig = survey_module.figure_from_message("bounds", "; ".join(problems))
     return {"value": fig["value"], "limit": fig["limit"], "unit": fig["unit"]}

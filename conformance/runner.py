@@ -45,7 +45,7 @@ class Run:
         self._items = [(t.body, t.link) for t in self.drawing.targets]
         # pyBullet's readings of every target when the current frame began, before its events and step
         # (the previous step's), and just before each event so far: the earlier poses a diagnosis tries
-        # (:mod:`conformance.diagnosis`). Kept as the run goes, because replaying the physics to find
+        # (:mod:`conformance.judge.diagnosis`). Kept as the run goes, because replaying the physics to find
         # them cost a run per failure; kept as read, because most runs never need them as poses.
         self._previous: tuple | None = None
         self._before_events: list[tuple[Event, tuple]] = []

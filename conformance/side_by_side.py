@@ -6,7 +6,7 @@ Both implementations run the same scene with the same parameters, each in its ow
 after set-up), then one step and one sync each per frame. At every frame, for every target:
 
 * the *gap*: the largest distance between the same vertex as A draws it and as B draws it;
-* each one's *error*: its worst vertex against the kit's truth (:func:`conformance.compare.compare_vertices`),
+* each one's *error*: its worst vertex against the kit's truth (:func:`conformance.judge.compare.compare_vertices`),
   in units of that target's tolerance.
 
 Besides, it notes the first frame at which either sync changed pyBullet's state (it must only read
@@ -29,11 +29,12 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from conformance import backends, compare, runner
+from conformance import backends, runner
+from conformance.judge import compare
 from conformance.bullet import truth
 from conformance.errors import SyncError
 from conformance.survey import times
-from conformance.tolerances import DEFAULT, Tolerance
+from conformance.judge.tolerances import DEFAULT, Tolerance
 
 __all__ = ["Judgement", "SceneComparison", "TargetComparison", "compare_scene", "verdict"]
 

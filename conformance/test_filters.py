@@ -17,7 +17,8 @@ from __future__ import annotations
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from conformance import compare, scenes
+from conformance import scenes
+from conformance.judge import compare
 from conformance.bullet.collisions import (
     FilterMode,
     GroupMask,

@@ -8,7 +8,8 @@ import pybullet
 import pytest
 from hypothesis import given
 
-from conformance import backends, compare, determinism, scenes
+from conformance import backends, determinism, scenes
+from conformance.judge import compare
 from conformance.errors import InvalidArgument
 from conformance.implementations.reference import ReferenceSync
 from conformance.profiles import check_settings

@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 from hypothesis import example, given, strategies as st
 
-from conformance import backends, compare, figures, profiles, scenes, shared_run, strategies
+from conformance import backends, figures, profiles, scenes, shared_run, strategies
+from conformance.judge import compare
 from conformance.bullet.events import turning_everything
 from conformance.profiles import check_settings
 from conformance.printed import rerun_check
@@ -215,5 +216,5 @@ def _bounds(run, kit):
 @each_scene()
 def test_drawn_bounds_agree_with_get_aabb(scene_name, kit):
     """Each drawn body's world bounding box lies inside pybullet's ``getAABB`` and reaches it on every
-    side within the stated margin (see ``conformance.tolerances``), at the first, middle and last frame."""
+    side within the stated margin (see ``conformance.judge.tolerances``), at the first, middle and last frame."""
     shared_run.report(kit, "test_drawn_bounds_agree_with_get_aabb", scene_name)

@@ -340,7 +340,7 @@ class PluginOptions:
     """Every option of the plugin, checked: what the session runs with."""
 
     sync: str
-    tolerances: dict[str, float]  # only those given; the rest keep conformance.tolerances.DEFAULT
+    tolerances: dict[str, float]  # only those given; the rest keep conformance.judge.tolerances.DEFAULT
     report: Path | None
     golden_dir: Path | None  # None: each scene's own (conformance.own_scenes.golden_dir)
     image_tolerance: str

@@ -3,7 +3,7 @@ extensions cannot be imported twice in one process, so everything the kit import
 before pytester snapshots ``sys.modules``."""
 
 import conformance.cli  # noqa: F401
-import conformance.compare  # noqa: F401
+import conformance.judge.compare  # noqa: F401
 import conformance.implementations.guide  # noqa: F401
 import conformance.pytest_helpers  # noqa: F401
 import conformance.runner  # noqa: F401

@@ -1,4 +1,4 @@
-"""Failures name the mistake when it is a known one (conformance.diagnosis): every wrong sync in
+"""Failures name the mistake when it is a known one (conformance.judge.diagnosis): every wrong sync in
 ``tests/`` whose mistake is in the catalogue gets its diagnosis, on both backends, at its first failing
 frame; mistakes outside the catalogue get none; and the line reaches the checks' failure messages and
 ``check``'s output."""
@@ -8,7 +8,8 @@ from __future__ import annotations
 import pytest
 
 import wrong_syncs
-from conformance import compare, diagnosis, runner, sync
+from conformance import runner, sync
+from conformance.judge import compare, diagnosis
 from conformance.bullet import events
 from right_syncs import PerTargetSync
 

@@ -56,7 +56,7 @@ def test_a_reproduce_line_keeps_the_tolerance_its_run_was_given(tmp_path):
     so, and `check` reads the option: without it the same line fails."""
     import dataclasses
 
-    from conformance.tolerances import DEFAULT
+    from conformance.judge.tolerances import DEFAULT
 
     loose = dataclasses.replace(DEFAULT, atol=1.0)
     line = reproduce_command("free_fall", "wrong_syncs:OneStepLate", 5, {}, tolerance=loose)

@@ -43,7 +43,7 @@ def test_each_example_reports_how_close_it_came_to_failing(monkeypatch):
     from conformance import profiles, sync
     from conformance.pytest_helpers import VERTEX_TARGET, Kit
     from conformance.test_vertices import check_run
-    from conformance.tolerances import DEFAULT
+    from conformance.judge.tolerances import DEFAULT
 
     seen: list[tuple[float, str]] = []
     monkeypatch.setattr(profiles, "target", lambda value, label: seen.append((value, label)))

@@ -21,7 +21,7 @@ import wrong_syncs
 from conformance import backends, survey, sync, verdicts
 from conformance import test_vertices as checks
 from conformance.pytest_helpers import Kit
-from conformance.tolerances import DEFAULT
+from conformance.judge.tolerances import DEFAULT
 
 Failed = pytest.fail.Exception
 TESTS = Path(__file__).resolve().parent

@@ -13,12 +13,13 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from conformance import backends, compare, sync
+from conformance import backends, sync
+from conformance.judge import compare
 from conformance import test_vertices as checks
 from conformance.bullet.events import Teleport
 from conformance.pytest_helpers import Kit
 from conformance.strategies import HARD_ORIENTATIONS
-from conformance.tolerances import DEFAULT
+from conformance.judge.tolerances import DEFAULT
 
 Failed = pytest.fail.Exception
 

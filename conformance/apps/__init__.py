@@ -67,7 +67,7 @@ def check_app(script, *, ticks: int = DEFAULT_TICKS, events=(), tick_function=No
               timeout: float | None = None) -> AppResult:
     """Run the app ``script`` under the kit and judge it (:func:`judge`)."""
     from conformance.apps import launch
-    from conformance.tolerances import DEFAULT
+    from conformance.judge.tolerances import DEFAULT
 
     kwargs = {} if timeout is None else {"timeout": timeout}
     recording = launch.record(script, ticks=ticks, events=events, tick_function=tick_function, **kwargs)

@@ -3,7 +3,7 @@
 A vertex drawn right is fixed in the link frame of one body or link (or in the world): its coordinates
 in that frame are the same at every tick. So, with no mapping from the user, the kit finds for each
 vertex the frame in which its coordinates vary least, and holds them to the kit's vertex tolerance
-there (:mod:`conformance.tolerances`: the same float32 and pybullet-helper budget as for a scene, per
+there (:mod:`conformance.judge.tolerances`: the same float32 and pybullet-helper budget as for a scene, per
 frame and actor). Because the reference coordinates are themselves read from the drawing (their
 median over the ticks), a vertex may be off by the tolerance at a tick and by the tolerance in the
 reference: the allowance is twice the tolerance.
@@ -31,7 +31,7 @@ from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
 from conformance.bullet import poses
-from conformance.tolerances import DEFAULT, Tolerance
+from conformance.judge.tolerances import DEFAULT, Tolerance
 
 __all__ = ["Attachment", "VARIANTS", "attach", "local_coordinates", "variant_fit"]
 

@@ -26,7 +26,7 @@ from conformance.apps import attachment as attach_mod, soft_bodies, welds
 from conformance.apps.verdict import DIAGNOSES, Verdict
 from conformance.apps.placement import bounding_radius, bounding_sphere, distance_to_shapes, place
 from conformance.apps.recording import Recording, vertex_ranges
-from conformance.tolerances import DEFAULT, Tolerance
+from conformance.judge.tolerances import DEFAULT, Tolerance
 
 __all__ = ["CHECKS", "DIAGNOSES", "Verdict", "judge"]
 

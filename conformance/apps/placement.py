@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from conformance.tolerances import DEFAULT, Tolerance
+from conformance.judge.tolerances import DEFAULT, Tolerance
 
 __all__ = ["Placement", "bounding_radius", "bounding_sphere", "candidates", "distance_to_shapes", "place", "shape_box"]
 

@@ -18,7 +18,7 @@ __all__ = ["POSITION", "TURN", "groups"]
 #: How far (m) and how much (rad) the relative pose of two welded frames may wander over a run. pyBullet
 #: keeps a fixed joint to its own rounding, not exactly: R2-D2's legs turned 1.7e-7 rad and moved 1.3e-7 m
 #: against its body over 20 ticks (measured). Frames whose relative pose wanders less than the vertex
-#: allowance (2.5e-5 m for a 1 m body, :mod:`conformance.tolerances`) cannot be told apart by the vertices
+#: allowance (2.5e-5 m for a 1 m body, :mod:`conformance.judge.tolerances`) cannot be told apart by the vertices
 #: they hold anyway; links that move relative to each other do so by millimetres a tick.
 POSITION = 1e-5
 TURN = 1e-5

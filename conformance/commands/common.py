@@ -26,7 +26,7 @@ def tolerance_of(args):
     import dataclasses
 
     from conformance import validation
-    from conformance.tolerances import DEFAULT
+    from conformance.judge.tolerances import DEFAULT
 
     values = {name: getattr(args, name, None) for name in TOLERANCES}  # a namespace made in code may lack them
     given = {name: validation.finite_non_negative(f"--conformance-{name.replace('_', '-')}", value)

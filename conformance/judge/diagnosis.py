@@ -224,7 +224,7 @@ def diagnose_frame(run, results) -> str:
 
 
 def explain_normals(run, result) -> tuple[str, str] | None:
-    """``(mistake, line)`` for a failing normals result (:class:`conformance.compare.NormalResult`): the
+    """``(mistake, line)`` for a failing normals result (:class:`conformance.judge.compare.NormalResult`): the
     first of :data:`NORMAL_MISTAKES` whose rotation turns the target's built normals into the drawn ones
     within twice the angle tolerance; None when none does (or the target's vertices are wrong too,
     which the vertex diagnosis covers)."""
@@ -291,7 +291,7 @@ def unannounced() -> str:
 def diagnose_problems(run) -> str:
     """The diagnosis of the worst problem of ``run`` as it stands now, in the order the checks report
     them: wrong vertices, then wrong normals, then a change not announced; ``""`` when none is known."""
-    from conformance import compare
+    from conformance.judge import compare
 
     vertices = compare.compare_vertices(run.drawing, run.frame)
     if not all(r.ok for r in vertices):

@@ -13,7 +13,7 @@ import numpy as np
 from conformance import backends
 from conformance.bullet import poses, shapes, truth
 from conformance.backends.common import Drawing
-from conformance.tolerances import DEFAULT, Tolerance
+from conformance.judge.tolerances import DEFAULT, Tolerance
 
 __all__ = [
     "BoundsResult",
@@ -256,7 +256,7 @@ class BoundsResult:
 
 def compare_bounds(drawing: Drawing, frame: int, tolerance: Tolerance = DEFAULT) -> list[BoundsResult]:
     """Each target's drawn box lies inside ``getAABB`` and reaches it on every side within the margin
-    stated in :mod:`conformance.tolerances`."""
+    stated in :mod:`conformance.judge.tolerances`."""
     p = drawing.world.p
     drawn = {}
     positions, orientations = truth.link_frames(p, [(t.body, t.link) for t in drawing.targets])
