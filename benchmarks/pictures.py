@@ -18,7 +18,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from conformance import backends, runner, scenes, sync
+from conformance import backends, scenes, sync
+from conformance.sync import runner
 from conformance.rendering import compare, silhouettes
 
 from .timing import Candidate, RatioToBaseline, race

@@ -72,7 +72,7 @@ def _ratio(error: float, tolerance: float) -> float:
 
 
 def check_frame(run, frame: int, tolerance=None) -> FrameCheck:
-    """Check ``run`` (a :class:`conformance.runner.Run`) as it stands at ``frame`` (to ``tolerance``, by
+    """Check ``run`` (a :class:`conformance.sync.runner.Run`) as it stands at ``frame`` (to ``tolerance``, by
     default the kit's)."""
     from conformance.judge import compare
 
@@ -220,7 +220,8 @@ def record(scene: str, implementation, frames: range, out: Path, *, size: tuple[
            tolerance=None) -> Animation:
     """Run ``scene`` with ``implementation`` (a loaded sync), check and render each frame of ``frames``,
     and write the animation to ``out``. Needs a display (:func:`conformance.backends.display.ensure_display`)."""
-    from conformance import backends, files, runner
+    from conformance import backends, files
+    from conformance.sync import runner
     from conformance.progress import progress
     from conformance.rendering import outline
 

@@ -16,7 +16,7 @@ Each command lives in its own module of :mod:`conformance.commands`:
 * ``documented``: pybullet's behaviour measured against its documentation, as a markdown table.
 
 Every command takes ``--scenes SOURCE`` (repeatable): a file or module of your own scenes, seen by the
-command and by every process it starts (:mod:`conformance.own_scenes`).
+command and by every process it starts (:mod:`conformance.sync.own_scenes`).
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ import argparse
 import importlib
 import sys
 
-from conformance import own_scenes
+from conformance.sync import own_scenes
 from conformance.commands import MODULES
 from conformance.errors import ConformanceError
 

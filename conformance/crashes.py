@@ -11,7 +11,7 @@ and the process that started pytest survives to give the verdict. What is guaran
   without the kit. A run given ``-n`` is already in workers. It is not isolated under ``--pdb`` or
   ``--trace`` (a debugger needs the test in the terminal's process), nor without pytest-xdist.
 * **A crash is a verdict.** Each worker notes, before every call into the sync, the check, the scene and
-  the step (one ``pwrite`` into a small file: :class:`conformance.crash_journal.Journal`), and has :mod:`faulthandler` write the
+  the step (one ``pwrite`` into a small file: :class:`conformance.sync.journal.Journal`), and has :mod:`faulthandler` write the
   stack to a file when the process dies of a signal. When a worker dies, its check fails with one
   paragraph: "the process crashed", the signal or exit status, the scene and step, the sync's stack
   as faulthandler wrote it (Python frames, innermost last; a native library's own frames are not
@@ -38,7 +38,7 @@ from pathlib import Path
 
 import pytest
 
-from conformance.crash_journal import INPUT_KEY, crash_file, when
+from conformance.sync.journal import INPUT_KEY, crash_file, when
 
 __all__ = ["Controller", "Watchdog", "allow_restarts", "arrange", "hard_limit"]
 
@@ -161,7 +161,7 @@ def hard_limit(sync_limit: float | None) -> float | None:
     """Seconds after which the controller stops a worker stuck in one sync call: twice the per-call limit
     and 5 s more (the alarm repeats every second, so a call Python can interrupt has long given way);
     None when calls have no limit."""
-    from conformance import time_limit
+    from conformance.sync import time_limit
 
     limit = time_limit.DEFAULT if sync_limit is None else sync_limit
     return 2 * limit + 5 if limit else None
@@ -252,7 +252,7 @@ def _reproduce(sync_spec: str, scene: str | None, nodeid: str) -> str:
     """The crashed check alone, in one process, with the scene's source for a user's scene."""
     import shlex
 
-    from conformance import own_scenes, printed
+    from conformance.sync import own_scenes, printed
 
     source = own_scenes.scene_arguments(scene) if scene else []
     return shlex.join([*printed.pytest(), "--pyargs", "conformance", "--sync", sync_spec, *source,

@@ -74,7 +74,7 @@ class SyncRaised(SyncError):
 
 class SyncTimedOut(SyncError):
     """A call into the sync implementation did not return within the time limit
-    (:mod:`conformance.time_limit`)."""
+    (:mod:`conformance.sync.time_limit`)."""
 
 
 class SyncCrashed(SyncError):

@@ -49,7 +49,7 @@ class Pictures:
     """What the image checks need from the session: where goldens are, which tolerance set, where
     to put pictures, whether to regenerate."""
 
-    golden_dir: Path | None  # None: each scene's own (conformance.own_scenes.golden_dir)
+    golden_dir: Path | None  # None: each scene's own (conformance.sync.own_scenes.golden_dir)
     tolerance: str  # one of conformance.validation.IMAGE_TOLERANCE_CHOICES
     results: Path
     keep_passing: bool
@@ -60,7 +60,7 @@ class Pictures:
     def golden_dir_for(self, scene: str) -> Path:
         """Where ``scene``'s goldens are read and regenerated: the directory given, else the scene's own
         (the kit's for its scenes, ``golden/<backend>/`` beside your file for yours)."""
-        from conformance import own_scenes
+        from conformance.sync import own_scenes
 
         return self.golden_dir if self.golden_dir is not None else own_scenes.golden_dir(scene)
 

@@ -7,7 +7,7 @@ kills no mistake on its own (it is kept for a reason the docs give, or it is str
 mistake that only one check kills (a single point of failure: weaken that check and the mistake
 passes). A cell is one of Stryker's mutant states, as they apply to a check: killed, survived,
 crashed (the process died in the sync: :mod:`conformance.crashes`), timed out (a sync call over its
-limit: :mod:`conformance.time_limit`), or not run (no record of the check: deselected).
+limit: :mod:`conformance.sync.time_limit`), or not run (no record of the check: deselected).
 """
 
 from __future__ import annotations

@@ -10,7 +10,7 @@ failure. What a mutant is, from that run (:func:`classify`):
 * **killed**: a check failed on it (``raised`` when the failure is the mutant raising in a step: the kit
   rejects it, but no property had to);
 * **crashed** / **timed out**: it killed its worker process, or a call did not return within the limit;
-  the kit rejects those too (:mod:`conformance.crashes`, :mod:`conformance.time_limit`);
+  the kit rejects those too (:mod:`conformance.crashes`, :mod:`conformance.sync.time_limit`);
 * **not viable**: it cannot be imported, or raises while being set up: it is not a sync at all;
 * **survived**: every check passed. A survivor is either *equivalent* (it draws the same thing: the
   argument is kept in :data:`VERDICTS_FILE`, by the mutant's :attr:`Mutant.id`) or a gap in the checks;

@@ -5,7 +5,7 @@ Options live under one group, each mirrored by an ini setting:
 * ``--sync SPEC`` / ``conformance_sync``: the implementation under test, a short name or
   ``module:attribute``; ``$CONFORMANCE_SYNC`` when neither is given; ``reference`` by default.
 * ``--conformance-sync-timeout SECONDS`` / ``conformance_sync_timeout``: the longest one call into the
-  sync may take (default 10 s, 0 for none; :mod:`conformance.time_limit`).
+  sync may take (default 10 s, 0 for none; :mod:`conformance.sync.time_limit`).
 * ``--conformance-isolation auto|process|none`` / ``conformance_isolation``: whether a serial run goes to
   one worker process, so that a sync that crashes the interpreter fails its checks (:mod:`conformance.crashes`).
 * ``--conformance-size-rtol``, ``--conformance-position-rtol``, ``--conformance-atol``,
@@ -181,7 +181,7 @@ def app_ticks(config: pytest.Config) -> int:
 def load_own_scenes(config: pytest.Config) -> None:
     """Register the user's scenes (``--conformance-scenes``, ini ``conformance_scenes``, ``$CONFORMANCE_SCENES``,
     entry points) before the checks are collected: they are parametrized over the registry at import."""
-    from conformance import own_scenes
+    from conformance.sync import own_scenes
     from conformance.errors import BadArgument
 
     try:
@@ -264,15 +264,15 @@ def _watch_for_crashes(config: pytest.Config) -> None:
 
 def pytest_sessionstart(session: pytest.Session) -> None:
     if hasattr(session.config, "workerinput"):  # after pytest's own faulthandler set-up, which it replaces
-        from conformance import crash_journal
+        from conformance.sync import journal
 
-        crash_journal.start_journal(session.config)
+        journal.start_journal(session.config)
 
 
 def pytest_runtest_logstart(nodeid: str, location) -> None:
-    from conformance import crash_journal
+    from conformance.sync import journal
 
-    crash_journal.noting(nodeid)
+    journal.noting(nodeid)
 
 
 def pytest_unconfigure(config: pytest.Config) -> None:

@@ -178,7 +178,7 @@ def rerun_command(spec: str, seed: int, factor: int, nodeid: str = "") -> str:
     from conformance.profiles import DRAW_FACTOR
 
     select = ["-k", nodeid.split("::", 1)[-1]] if nodeid else []
-    from conformance import printed
+    from conformance.sync import printed
 
     return f"{DRAW_FACTOR}={factor} " + shlex.join([printed.python(), "-m", "pytest", "--pyargs", "conformance", "--sync", spec,
                                                     *pytest_args(seed), *select])

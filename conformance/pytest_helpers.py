@@ -23,7 +23,7 @@ from conformance.judge import compare, diagnosis
 from conformance.bullet import events as events_module
 from conformance.errors import SyncError
 from conformance.survey import WORST  # noqa: F401  (where the plugin and older callers find it)
-from conformance.printed import reproduce_command
+from conformance.sync.printed import reproduce_command
 from conformance.judge.tolerances import Tolerance
 
 #: The label of the vertex checks' ``hypothesis.target``: the worst vertex error over its tolerance.
@@ -74,7 +74,7 @@ def _label(scene: str, params: Mapping[str, Any]) -> str:
 def sync_run(scene: str, implementation, events: Sequence = (), **params: Any) -> Iterator[Any]:
     """``runner.running`` for a check: a sync implementation that raises fails the check with one clear
     paragraph instead of a traceback through the kit."""
-    from conformance import runner
+    from conformance.sync import runner
 
     try:
         with runner.running(scene, implementation, events=events, **params) as run:

@@ -29,7 +29,8 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from conformance import backends, runner
+from conformance import backends
+from conformance.sync import runner
 from conformance.judge import compare
 from conformance.bullet import truth
 from conformance.errors import SyncError

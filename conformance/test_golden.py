@@ -40,7 +40,7 @@ def _reproduce(check: str, scene: str, sync: str, variant: dict | None = None, p
     verdict: the user's scenes, and the golden directory and image tolerance given."""
     import os
 
-    from conformance.printed import rerun_check
+    from conformance.sync.printed import rerun_check
 
     # The whole id, brackets included: "mixed_shapes" alone would select its variants' checks too.
     selected = f"{check}[{scene}-{variant_id(variant)}]" if variant else f"{check}[{scene}]"
@@ -93,7 +93,7 @@ def test_golden_render(scene_name, variant, kit, pictures, request):
         record, images = reftest.judge(golden, drawn[frame], references[frame], here=pictures.renderer,
                                        override=pictures.override, sync=kit.sync)
         if "difference" in images and not blamed:  # the sync's verdict failed: name the bodies, once
-            from conformance.printed import reproduce_command
+            from conformance.sync.printed import reproduce_command
 
             blamed = [f"{reftest.bodies_where_pixels_differ(scene_name, golden, variant, references[frame], drawn[frame])}"
                       f" [{scene_name}, frame {frame}]; the vertices, frame by frame (a mistake there is named): "
@@ -130,7 +130,7 @@ def test_golden_physics(scene_name, pictures):
                           f"physics differs from the golden's stored state, {v.difference.describe()}; its picture "
                           "verdicts restore the stored state and stay valid")
     if failed:
-        from conformance import own_scenes
+        from conformance.sync import own_scenes
         from conformance.rendering import golden
 
         # A user's scene most likely changed itself (a body moved, a mass changed); the kit's scenes are
@@ -151,7 +151,7 @@ def test_no_stale_goldens(pictures):
 
     found = [path for paths in golden.stale_by_directory(pictures.golden_dir_for).values() for path in paths]
     if found:
-        from conformance import own_scenes, printed
+        from conformance.sync import own_scenes, printed
 
         given = ["--golden-dir", str(pictures.golden_dir)] if pictures.golden_dir is not None else []
         # the run's own scenes too: without them regen sees only the kit's, and would take their goldens for stale

@@ -38,7 +38,7 @@ def test_builds_across_parameters(scene_name):
     """Every parameter set the scene's strategy can draw builds, steps and stays finite."""
     spec = scenes.get(scene_name)
     if spec.parameters is None:
-        from conformance import own_scenes
+        from conformance.sync import own_scenes
 
         if own_scenes.source_of(scene_name) is not None:  # yours: optional; the kit's: required
             pytest.skip(f"scene {scene_name!r} declares no parameter strategy (SceneSpec.parameters), so only its "

@@ -65,7 +65,8 @@ def test_scene_camera_frames_every_body(scene_name, pictures, request):
     """The scene's goldens show it: at each golden frame, drawn by the reference sync, every body is
     inside the picture and the clipping range, at least 3 px across, and the picture is not blank.
     A property of the scene and its camera, not of the sync under test."""
-    from conformance import runner, sync
+    from conformance import sync
+    from conformance.sync import runner
 
     with runner.running(scene_name, sync.load("reference")) as run:
         camera, size = run.scene.camera, run.scene.image_size

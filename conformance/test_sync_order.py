@@ -66,7 +66,7 @@ def rerun_command(scene: str, sync: str) -> str:
     """The run of this check on this scene again, under the Hypothesis profile in force (a derandomized
     profile replays the same programs; under the random default, Hypothesis' database replays the failing
     one where the run was made, and its ``@reproduce_failure`` line, printed with the failure, anywhere)."""
-    from conformance import own_scenes, printed
+    from conformance.sync import own_scenes, printed
 
     return shlex.join([printed.python(), "-m", "pytest", "--pyargs", "conformance", "-p", "no:randomly", "-k",
                        f"{CHECK} and {scene}", "--sync", sync, *own_scenes.scene_arguments(scene),

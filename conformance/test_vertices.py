@@ -17,7 +17,7 @@ from conformance import backends, figures, profiles, scenes, shared_run, strateg
 from conformance.judge import compare
 from conformance.bullet.events import turning_everything
 from conformance.profiles import check_settings
-from conformance.printed import rerun_check
+from conformance.sync.printed import rerun_check
 from conformance.pytest_helpers import _context, bounds_figure, each_scene
 
 

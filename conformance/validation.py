@@ -342,7 +342,7 @@ class PluginOptions:
     sync: str
     tolerances: dict[str, float]  # only those given; the rest keep conformance.judge.tolerances.DEFAULT
     report: Path | None
-    golden_dir: Path | None  # None: each scene's own (conformance.own_scenes.golden_dir)
+    golden_dir: Path | None  # None: each scene's own (conformance.sync.own_scenes.golden_dir)
     image_tolerance: str
     results: Path
     keep_passing: bool

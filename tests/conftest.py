@@ -6,7 +6,7 @@ import conformance.cli  # noqa: F401
 import conformance.judge.compare  # noqa: F401
 import conformance.implementations.guide  # noqa: F401
 import conformance.pytest_helpers  # noqa: F401
-import conformance.runner  # noqa: F401
+import conformance.sync.runner  # noqa: F401
 import conformance.test_scenes  # noqa: F401
 import conformance.test_vertices  # noqa: F401
 import PIL.Image  # noqa: F401
@@ -15,7 +15,7 @@ import pytest
 pytest_plugins = ["pytester"]
 
 # `./kit test` runs these tests with the variable `./kit` sets for its commands; the commands the kit
-# prints then name the kit's interpreter (conformance.printed). The tests read those lines as a user who
+# prints then name the kit's interpreter (conformance.sync.printed). The tests read those lines as a user who
 # installed the kit where their `python` is; tests/test_printed_commands.py sets it back on purpose.
 import os  # noqa: E402
 

@@ -18,7 +18,7 @@ from PIL import Image, ImageSequence
 
 from conformance import animation, cli, scenes
 from conformance.rendering import outline
-from conformance.printed import reproduce_command
+from conformance.sync.printed import reproduce_command
 
 
 def _render(argv, cwd: Path) -> tuple[int, str, str]:
@@ -108,7 +108,8 @@ def test_the_outline_is_the_edge_of_the_regions_it_outlines():
 
 
 def test_the_outline_is_drawn_where_pybullet_has_the_body_and_a_right_drawing_fills_it():
-    from conformance import backends, runner, sync
+    from conformance import backends, sync
+    from conformance.sync import runner
     from conformance.rendering import silhouettes
 
     size = (200, 150)

@@ -11,7 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from conformance import backends, runner, sync
+from conformance import backends, sync
+from conformance.sync import runner
 
 pytestmark = pytest.mark.skipif(backends.NAME != "pygfx", reason="per-buffer, per-range uploads are pygfx's; "
                                 "FURY 0.12 re-uploads all of an actor's geometry on any Modified()")

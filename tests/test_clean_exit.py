@@ -120,7 +120,8 @@ def _kill(process: subprocess.Popen, signum: int) -> int:
 #: Renders a picture (so an X connection is open, as in a real run), says its Xvfb, then waits.
 RENDER_AND_WAIT = """
 import os, time
-from conformance import backends, runner, sync
+from conformance import backends, sync
+from conformance.sync import runner
 from conformance.backends import display
 with runner.running("free_fall", sync.load("reference")) as run:
     backends.render(run.drawing, run.scene.camera, (64, 48))

@@ -18,7 +18,8 @@ pytestmark = pytest.mark.skipif(backends.NAME != "pygfx" or not sys.platform.sta
 RENDER_AND_WAIT = """
 import os, time
 import numpy as np
-from conformance import backends, runner, sync
+from conformance import backends, sync
+from conformance.sync import runner
 from conformance.backends import display
 with runner.running("free_fall", sync.load("reference")) as run:
     picture = backends.render(run.drawing, run.scene.camera, (64, 48))

@@ -8,7 +8,8 @@ from __future__ import annotations
 import pytest
 
 import wrong_syncs
-from conformance import runner, sync
+from conformance import sync
+from conformance.sync import runner
 from conformance.judge import compare, diagnosis
 from conformance.bullet import events
 from right_syncs import PerTargetSync

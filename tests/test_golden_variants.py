@@ -12,7 +12,8 @@ from __future__ import annotations
 
 import pytest
 
-from conformance import backends, runner, scenes, sync
+from conformance import backends, scenes, sync
+from conformance.sync import runner
 from conformance.errors import InvalidArgument
 from conformance.pytest_helpers import variant_id
 from conformance.rendering import compare, golden, snapshots

@@ -19,7 +19,8 @@ from pathlib import Path
 
 import pytest
 
-from conformance import runner, scenes, sync
+from conformance import scenes, sync
+from conformance.sync import runner
 from conformance.rendering import compare, golden, silhouettes, snapshots
 
 TESTS = Path(__file__).resolve().parent

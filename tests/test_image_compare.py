@@ -8,7 +8,7 @@ from conformance.errors import ImageSizeMismatch, InvalidArgument
 from conformance.rendering.compare import (OTHER_RENDERER, SAME_RENDERER, compare_images, difference_image,
                                            tolerance)
 from conformance.rendering.measure_tolerances import ERRORS, perturbed, pick_target, with_noise
-from conformance.runner import running
+from conformance.sync.runner import running
 
 SCENES = ("sliding_box", "free_fall", "domino")
 

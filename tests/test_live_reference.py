@@ -20,7 +20,8 @@ from pathlib import Path
 import pytest
 
 from children import environment, run as run_child, said
-from conformance import backends, runner, scenes, sync
+from conformance import backends, scenes, sync
+from conformance.sync import runner
 from conformance.rendering import golden, measure_reftest, measure_tolerances, reftest, snapshots
 
 TESTS = Path(__file__).resolve().parent

@@ -218,7 +218,7 @@ def test_a_printed_command_names_the_scene_file_even_when_populate_lives_in_a_he
     (tmp_path / "my_scenes.py").write_text("from conformance.scenes import Camera, SceneSpec, Shape\n"
                                            "from die_helpers import populate\n\n\ndef parameters():" + rest,
                                            encoding="utf-8")
-    probe = ("from conformance import own_scenes\n"
+    probe = ("from conformance.sync import own_scenes\n"
              "own_scenes.load('my_scenes.py')\n"
              "print(own_scenes.scene_arguments('tossed_die'))\n")
     done = subprocess.run([sys.executable, "-c", probe], cwd=tmp_path, capture_output=True, text=True, timeout=300)
@@ -233,7 +233,7 @@ def test_a_scene_from_a_module_is_named_by_the_module_and_its_goldens_sit_beside
     package.mkdir()
     (package / "__init__.py").write_text("")
     (package / "scenes.py").write_text(_example(), encoding="utf-8")
-    probe = ("from conformance import own_scenes\n"
+    probe = ("from conformance.sync import own_scenes\n"
              "own_scenes.load('mypkg.scenes')\n"
              "print(own_scenes.scene_arguments('tossed_die'))\n"
              "print(own_scenes.golden_dir('tossed_die').relative_to(__import__('os').getcwd()))\n")

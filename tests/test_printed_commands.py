@@ -1,6 +1,6 @@
 """A command the kit prints runs as printed from where the user is (issue 30). After ``./kit``, whose
 environment is never activated, ``python`` and ``pytest`` on the user's PATH may lack the kit or have
-the other FURY: the printed lines name the kit's interpreter (:mod:`conformance.printed`)."""
+the other FURY: the printed lines name the kit's interpreter (:mod:`conformance.sync.printed`)."""
 
 from __future__ import annotations
 
@@ -11,8 +11,9 @@ import sys
 from pathlib import Path
 
 
-from conformance import apps, printed
-from conformance.printed import reproduce_command
+from conformance import apps
+from conformance.sync import printed
+from conformance.sync.printed import reproduce_command
 from conformance.rendering.golden import regen_command
 
 import app_sources
@@ -73,7 +74,8 @@ def test_a_reproduce_line_keeps_the_tolerance_its_run_was_given(tmp_path):
 
 def test_a_silhouette_failure_reproduces_with_the_check_itself_not_with_check():
     """`check` compares vertices only: a silhouette's reproduce line reruns the silhouette check."""
-    from conformance import runner, sync
+    from conformance import sync
+    from conformance.sync import runner
     from conformance.rendering.silhouettes import silhouette_check
 
     with runner.running("free_fall", sync.load("reference")) as run:

@@ -11,7 +11,8 @@ import numpy as np
 import pybullet
 import pytest
 
-from conformance import backends, runner, scenes, sync
+from conformance import backends, scenes, sync
+from conformance.sync import runner
 from conformance.rendering import framing, silhouettes
 from conformance.backends import projection
 

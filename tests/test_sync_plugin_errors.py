@@ -93,7 +93,7 @@ def _assert_one_paragraph_failure(result, *needles: str) -> None:
     for needle in needles:
         assert needle in out, f"{needle!r} not in:\n{out}"
     # pytrace=False: the report is the message, not a traceback through the kit's frames.
-    assert "conformance/runner.py" not in out and "def sync_run" not in out
+    assert "conformance/sync/runner.py" not in out and "def sync_run" not in out
 
 
 def test_factory_that_raises_fails_the_check(pytester):

@@ -1,5 +1,5 @@
 """A sync call that does not return within the time limit fails its check with where it was, and the
-run goes on: :mod:`conformance.time_limit` and ``--conformance-sync-timeout`` (issue: syncs that hang)."""
+run goes on: :mod:`conformance.sync.time_limit` and ``--conformance-sync-timeout`` (issue: syncs that hang)."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from conformance import time_limit
+from conformance.sync import time_limit
 
 from hanging_syncs import CALL, SCENE
 

@@ -53,7 +53,7 @@ class AppResult:
 def reproduce_command(script: str, ticks: int, events=(), tick_function: str | None = None) -> str:
     """The command that runs this run of the app again, with the --tick it was given (without it, an
     app whose loop is its own cannot be run)."""
-    from conformance import printed
+    from conformance.sync import printed
 
     command = f"{shlex.quote(printed.python())} -m conformance app {shlex.quote(str(script))} --ticks {ticks}"
     if tick_function:

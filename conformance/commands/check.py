@@ -27,7 +27,8 @@ def add_arguments(parser) -> None:
 
 
 def run(args, extra) -> int:
-    from conformance import runner, scenes, sync
+    from conformance import scenes, sync
+    from conformance.sync import runner
     from conformance.judge import diagnosis
     from conformance.bullet import events
     from conformance.animation import check_frame

@@ -24,7 +24,8 @@ def add_arguments(parser) -> None:
 
 
 def run(args, extra) -> int:
-    from conformance import own_scenes, scenes
+    from conformance import scenes
+    from conformance.sync import own_scenes
     from conformance.backends.display import virtual_display
     from conformance.progress import progress
     from conformance.rendering import snapshots
@@ -54,7 +55,7 @@ def _prune(given, directories: set) -> int:
     """Delete :func:`conformance.rendering.golden.stale` files of each of ``directories``, then its emptied
     folders. What a directory must keep is every registered scene's goldens there, not only the scenes
     named: ``regen --prune chain`` prunes chain's directory and never deletes another scene's goldens."""
-    from conformance import own_scenes
+    from conformance.sync import own_scenes
     from conformance.rendering import golden
 
     stale = golden.stale_by_directory(lambda name: given if given is not None else own_scenes.golden_dir(name))

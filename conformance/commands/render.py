@@ -126,7 +126,8 @@ def _validated(args) -> _Request:
 
 
 def _render_one(name: str, request: _Request) -> None:
-    from conformance import backends, files, runner
+    from conformance import backends, files
+    from conformance.sync import runner
 
     spec = request.specs[name]
     step = request.step if request.step is not None else (spec.poster_step or spec.steps)

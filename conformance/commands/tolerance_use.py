@@ -30,7 +30,7 @@ def run(args, extra) -> int:
     for spec in specs:  # a spec that cannot load fails now, in one paragraph
         sync.load(spec)
     outcomes = verdicts.check_all(specs, pytest_args=extra, jobs=args.jobs)
-    from conformance import printed
+    from conformance.sync import printed
 
     sources = [w for source in args.scenes for w in ("--scenes", source)]
     failed = [o.spec for o in outcomes if not o.passed]

@@ -10,7 +10,7 @@ target whose vertices are right and whose stored normals are not is tried the sa
 normals' mistakes (:data:`NORMAL_MISTAKES`), and a change never announced is named as such.
 
 The poses pyBullet had earlier (the previous step, before a teleport or a joint reset) are the ones
-the run kept as it went (:class:`conformance.runner.Run`'s ``previous`` and ``before_events``): one
+the run kept as it went (:class:`conformance.sync.runner.Run`'s ``previous`` and ``before_events``): one
 read of every target's pose per frame, where replaying the physics up to each failing frame made a
 wrong sync's survey of a long scene cost a run per failing frame.
 """
@@ -105,7 +105,7 @@ class _Physics:
 
 
 def _physics(run) -> _Physics:
-    """pyBullet's poses of every target of ``run`` (a :class:`conformance.runner.Run`) now, and the
+    """pyBullet's poses of every target of ``run`` (a :class:`conformance.sync.runner.Run`) now, and the
     earlier ones the run kept as it went."""
     p = run.drawing.world.p
     items = [(u.body, u.link) for u in run.drawing.targets]

@@ -33,7 +33,7 @@ import numpy as np
 
 from conformance.errors import GoldenError, GoldenMissing, GoldenUnreadable
 from conformance.files import encode_png, write_atomically
-from conformance.own_scenes import default_dir  # where a scene's goldens live is own_scenes' to say
+from conformance.sync.own_scenes import default_dir  # where a scene's goldens live is own_scenes' to say
 
 __all__ = ["FORMAT", "Golden", "default_dir", "encode_manifest", "jsonable", "library_versions", "paths", "read", "regen_command", "same_renderer", "stale", "stale_by_directory", "write"]
 
@@ -80,7 +80,7 @@ def regen_command(scene: str, directory: Path | str | None = None) -> str:
     """The whole command that (re)makes a scene's goldens in ``directory`` (all its frames together:
     they share one run): with ``--scenes`` for a user's scene and ``--golden-dir`` unless ``directory``
     is where the scene's goldens live by default."""
-    from conformance import own_scenes, printed
+    from conformance.sync import own_scenes, printed
 
     words = [printed.python(), "-m", "conformance", "regen", scene, *own_scenes.scene_arguments(scene)]
     if directory is not None and Path(directory).resolve() != own_scenes.golden_dir(scene).resolve():

@@ -42,7 +42,8 @@ def _counts(expected, actual) -> dict[str, int]:
 
 def measure_scene(scene_name: str) -> list[dict]:
     """One row of numbers per golden frame of ``scene_name`` (see the module docstring)."""
-    from conformance import backends, runner, scenes, sync
+    from conformance import backends, scenes, sync
+    from conformance.sync import runner
     from conformance.errors import GoldenError
     from conformance.rendering import compare, golden, measure_tolerances, reftest, snapshots
 

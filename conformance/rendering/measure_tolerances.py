@@ -172,7 +172,7 @@ def render_frames(scene: str, *, variants: bool = True) -> dict[tuple[int, str],
     ``(frame, change)`` for ``msaa_off`` and each of :data:`ERRORS` (``turned`` skipped where every
     body is a sphere: a turned tessellated sphere is a different question)."""
     from conformance import backends, scenes, sync
-    from conformance.runner import running
+    from conformance.sync.runner import running
 
     spec = scenes.get(scene)
     images = {}

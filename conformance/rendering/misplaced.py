@@ -46,7 +46,7 @@ def note(node, run, failures: Sequence[Any], worst, *, sync: str, message: str, 
     if node is None or (first and PICTURE in node.stash) or not _final_example():
         return
     from conformance.bullet import events as events_module
-    from conformance.printed import reproduce_command
+    from conformance.sync.printed import reproduce_command
     from conformance.rendering import golden, outline
 
     names = sorted({r.target for r in failures})

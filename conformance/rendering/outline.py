@@ -43,7 +43,7 @@ def edges(ids: np.ndarray, which: Iterable[int], width: int = WIDTH) -> np.ndarr
 
 
 def expected_outline(run, names: Iterable[str], size: tuple[int, int] | None = None) -> np.ndarray:
-    """The outline (:func:`edges`) of the targets ``names`` of ``run`` (a :class:`conformance.runner.Run`)
+    """The outline (:func:`edges`) of the targets ``names`` of ``run`` (a :class:`conformance.sync.runner.Run`)
     where pyBullet has them now, seen from the scene's camera at ``size`` (default: the scene's)."""
     scene = run.scene
     size = tuple(size) if size else tuple(scene.image_size)

@@ -55,7 +55,8 @@ def references(scene_name: str, goldens: Mapping[int, storage.Golden], variant: 
     a golden variant's parameters: its shared actors) and drawn by the ``reference`` sync on this
     process's renderer. Cached per process by the state, so two goldens holding the same state (a copy
     made elsewhere) share one render."""
-    from conformance import backends, runner, scenes, sync
+    from conformance import backends, scenes, sync
+    from conformance.sync import runner
     from conformance.bullet import state
 
     defaults = scenes.get(scene_name).defaults  # a parameter at its default is no variant: one cache entry
@@ -159,7 +160,8 @@ def bodies_where_pixels_differ(scene_name: str, golden: storage.Golden, variant:
     state, rendered with one id per target). A body drawn where it is not, or not redrawn, shows as its
     name; pixels where pyBullet puts no body are something drawn where nothing is. One more scene built
     and one id picture: made only for a failure."""
-    from conformance import backends, runner, scenes, sync
+    from conformance import backends, scenes, sync
+    from conformance.sync import runner
     from conformance.bullet import state
 
     defaults = scenes.get(scene_name).defaults

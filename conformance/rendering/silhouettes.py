@@ -409,7 +409,7 @@ def silhouette_record(run, sync: str, ids_fury, ids_bullet, check: str, toleranc
         radii=projected_radii(scene, scene.bindings, scene.camera, scene.image_size),
         names=[t.name for t in run.drawing.targets], scene=scene.name, frame=run.frame,
         touching=touching_pairs(scene, scene.bindings, ids_fury, ids_bullet))
-    from conformance.printed import reproduce_command, rerun_check
+    from conformance.sync.printed import reproduce_command, rerun_check
     from conformance.rendering.golden import jsonable
 
     record.sync = sync

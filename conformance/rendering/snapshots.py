@@ -61,7 +61,8 @@ def manifest(run, frame: int, captured: dict[str, Any], renderer: dict[str, str]
 def make(scene_name: str) -> list[tuple[int, np.ndarray, dict[str, Any]]]:
     """Run ``scene_name`` (default parameters) with the reference sync; at each golden frame, the
     picture and its manifest."""
-    from conformance import runner, scenes, sync
+    from conformance import scenes, sync
+    from conformance.sync import runner
 
     wanted = sorted(set(scenes.get(scene_name).frames_with_goldens()))
     renderer = backends.renderer_info()

@@ -12,7 +12,8 @@ import os
 import fury
 from fury import window
 
-from conformance import runner, sync
+from conformance import sync
+from conformance.sync import runner
 
 SCENE = os.environ["KIT_SCENE"]
 STEPS = int(os.environ.get("KIT_STEPS", "60"))

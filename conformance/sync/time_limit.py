@@ -62,7 +62,7 @@ def limited(seconds: float | None) -> Iterator[None]:
 def stack(exc: BaseException, *, limit: int = 6) -> str:
     """The innermost frames of ``exc``'s traceback (where the call was when it expired), the kit's own
     left out unless there are no others, as indented ``File …, line …, in …`` lines with their source."""
-    kit = os.path.dirname(os.path.abspath(__file__)) + os.sep
+    kit = os.path.dirname(os.path.dirname(os.path.abspath(__file__))) + os.sep  # conformance/, not only sync/
     frames = [f for f in traceback.extract_tb(exc.__traceback__) if os.path.abspath(f.filename) != os.path.abspath(__file__)]
     outside = [f for f in frames if not os.path.abspath(f.filename).startswith(kit)]
     return "".join(traceback.format_list((outside or frames)[-limit:])).rstrip()

@@ -53,7 +53,7 @@ def tolerance_arguments(tolerance) -> list[str]:
 def rerun_check(check_id: str, scene: str, sync: str, tolerance=None, given: Sequence[str] = ()) -> str:
     """The pytest command that runs the check ``check_id`` (its whole id: ``test_x[scene]``) again, with the
     scene's source for a user's scene, the tolerance of this run, and the options ``given``."""
-    from conformance import own_scenes
+    from conformance.sync import own_scenes
 
     return shlex.join([*pytest(), "--pyargs", "conformance", "-k", check_id, "--sync", sync,
                        *own_scenes.scene_arguments(scene), *tolerance_arguments(tolerance), *given])
@@ -63,7 +63,7 @@ def reproduce_command(scene: str, sync: str, frames: int, params: Mapping[str, A
                       tolerance=None) -> str:
     """The command line that replays a run frame by frame and prints every target's error (the vertex
     checks': vertices, normals and announcements), to ``tolerance`` when it is not the kit's."""
-    from conformance import own_scenes
+    from conformance.sync import own_scenes
 
     words = [python(), "-m", "conformance", "check", scene, *own_scenes.scene_arguments(scene), "--sync", sync,
              "--frames", str(frames), *tolerance_arguments(tolerance)]

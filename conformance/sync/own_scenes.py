@@ -200,7 +200,7 @@ def default_dir() -> Path:
     ``conformance/golden/<backend>/`` in a wheel (renderers differ, so each backend has its own)."""
     from conformance import backends
 
-    return Path(__file__).resolve().parent / "golden" / backends.NAME
+    return Path(__file__).resolve().parent.parent / "golden" / backends.NAME  # conformance/golden
 
 
 def golden_dir(name: str) -> Path:

@@ -26,8 +26,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable
 
-from conformance import crash_journal
-from conformance import time_limit as limits
+from conformance.sync import journal
+from conformance.sync import time_limit as limits
 from conformance.errors import SyncLoadError, SyncProtocolError, SyncRaised, SyncTimedOut
 from conformance.implementations import SHORT_NAMES
 from conformance.validation import SYNC_ENV_VAR
@@ -46,7 +46,7 @@ def _exception_line(exc: BaseException) -> str:
 
 def _user_location(exc: BaseException) -> str:
     """File and line of the innermost frame outside the kit, where the plug-in went wrong."""
-    kit = os.path.dirname(os.path.abspath(__file__))
+    kit = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))  # conformance/, not only sync/
     frames = [
         f for f in traceback.extract_tb(exc.__traceback__)
         if not f.filename.startswith("<") and not os.path.abspath(f.filename).startswith((kit, _IMPORTLIB))
@@ -64,7 +64,7 @@ class SyncImplementation:
     spec: str
     target: str  # the module:attribute it resolved to
     factory: Callable[[World], Callable[[], None]]
-    #: seconds each call into the implementation may take (None or 0: no limit; :mod:`conformance.time_limit`)
+    #: seconds each call into the implementation may take (None or 0: no limit; :mod:`conformance.sync.time_limit`)
     time_limit: float | None = limits.DEFAULT
 
     @property
@@ -74,8 +74,8 @@ class SyncImplementation:
 
     def start(self, world: World) -> "Syncer":
         """Call the factory for ``world``; errors become :class:`~conformance.errors.SyncError`."""
-        crash_journal.check_not_crashed(self.spec, world.scene)
-        crash_journal.at(world.scene, None)
+        journal.check_not_crashed(self.spec, world.scene)
+        journal.at(world.scene, None)
         try:
             with limits.limited(self.time_limit):
                 step_fn = self.factory(world)
@@ -87,7 +87,7 @@ class SyncImplementation:
                 f"{_exception_line(exc)}{_user_location(exc)}."
             ) from exc
         finally:
-            crash_journal.returned()
+            journal.returned()
         if not callable(step_fn):
             raise SyncProtocolError(
                 f"sync implementation {self.spec!r} returned {step_fn!r} (type {type(step_fn).__name__}) for scene "
@@ -114,7 +114,7 @@ class Syncer:
 
     def __call__(self, frame: int) -> None:
         self.frame = frame
-        crash_journal.at(self.scene, frame)
+        journal.at(self.scene, frame)
         try:
             with limits.limited(self.time_limit):
                 self._fn()
@@ -126,7 +126,7 @@ class Syncer:
                 f"{_exception_line(exc)}{_user_location(exc)}."
             ) from exc
         finally:
-            crash_journal.returned()
+            journal.returned()
 
 
 def _check_arity(fn: Any, n: int, what: str) -> None:
