@@ -136,7 +136,7 @@ class Controller:
         """The crash as a row of ``report.html`` (kind ``crashed``, no pictures: the process that would
         have drawn them is gone), written by the controller, which outlives it."""
         from conformance import image_options
-        from conformance.rendering import artefacts
+        from conformance.reports import artefacts
         from conformance.rendering.records import ImageCheck
 
         reproduce = next((line.split(": ", 1)[1] for line in message.splitlines() if line.startswith("reproduce")), "")

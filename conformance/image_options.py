@@ -79,7 +79,7 @@ class Pictures:
 
     def keep(self, record, images: dict[str, Any]) -> None:
         """Write a check's pictures (failures always; passes when asked) and its record."""
-        from conformance.rendering import artefacts
+        from conformance.reports import artefacts
 
         record.details.setdefault("renderer", self.renderer)
         artefacts.write_artefacts(record, self.results, images if (not record.passed or self.keep_passing) else {})
@@ -101,13 +101,13 @@ class Pictures:
     def start_session(self) -> None:
         """Forget the pictures and records of an earlier run (only what the kit writes there), so
         the report shows this run alone. Called once, by the controller, before any check runs."""
-        from conformance.rendering import artefacts
+        from conformance.reports import artefacts
 
         artefacts.clear(self.results)
         (self.results / "report.html").unlink(missing_ok=True)
 
     def write_report(self, sync: str):
-        from conformance.rendering import artefacts, report
+        from conformance.reports import artefacts, report
 
         if not self.results.is_dir():
             return None

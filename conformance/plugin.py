@@ -416,7 +416,7 @@ def pytest_runtest_makereport(item: pytest.Item, call):
     survey.settle(item, report)  # survey mode: a check that noted failures fails now, naming every kind
     if report.when == "call":
         from conformance import image_options
-        from conformance.rendering import misplaced
+        from conformance.reports import misplaced
 
         misplaced.keep(item, report, image_options.from_config(item.config))
     if report.when == "call" and report.failed and _is_property(item):

@@ -281,8 +281,8 @@ class Kit:
         self._announced[run] = len(run.unannounced)
 
     def _picture(self, run: Any, failures: Sequence[Any], message: str | None, drawn: Callable[[], dict[str, Any]]) -> None:
-        """The failing frame's picture for the report, with pyBullet's outline (:mod:`conformance.rendering.misplaced`)."""
-        from conformance.rendering import misplaced
+        """The failing frame's picture for the report, with pyBullet's outline (:mod:`conformance.reports.misplaced`)."""
+        from conformance.reports import misplaced
 
         worst = _largest(failures)
         if message is None:  # survey mode: the first failure's words, made only if its picture is kept

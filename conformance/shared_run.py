@@ -27,7 +27,7 @@ from typing import Any, Callable
 import pytest
 
 from conformance import scenes, survey as survey_module
-from conformance.rendering import misplaced
+from conformance.reports import misplaced
 from conformance.errors import SyncError
 
 __all__ = ["Watcher", "WATCHERS", "report", "seen", "watcher"]

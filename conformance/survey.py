@@ -292,7 +292,7 @@ def _image_figures(item, report) -> dict[str, dict[str, Any]]:
     image checks keep in the results directory: their measured numbers, frame by frame."""
     try:
         from conformance import image_options
-        from conformance.rendering import artefacts
+        from conformance.reports import artefacts
 
         records = artefacts.read_records(image_options.from_config(item.config).results)
     except Exception:  # no results directory, or no image options in this session: nothing to add

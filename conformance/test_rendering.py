@@ -5,7 +5,8 @@ Golden-image comparison builds on this; if it fails, no tolerance can be trusted
 
 from __future__ import annotations
 
-from conformance import backends, images
+from conformance import backends
+from conformance.rendering import images
 from conformance.pytest_helpers import each_scene, sync_run
 
 

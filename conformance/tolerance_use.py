@@ -65,7 +65,7 @@ class Use:
 
 
 def _at_least(metric: str) -> bool:
-    from conformance.rendering.report import AT_LEAST_PREFIXES
+    from conformance.reports.report import AT_LEAST_PREFIXES
 
     name = metric.split(": ")[-1]  # a golden's "sync: iou" is judged like "iou"
     return name.startswith(AT_LEAST_PREFIXES) or name.endswith("_iou")

@@ -120,7 +120,7 @@ def check(spec: str, *, stop_at_first: bool = False, survey: bool = False, pytes
             data = json.load(fh)
         import dataclasses
 
-        from conformance.rendering.artefacts import read_records
+        from conformance.reports.artefacts import read_records
 
         images = [dataclasses.asdict(r) for r in read_records(os.path.join(tmp, "results"))]
         return Outcome(spec, proc.returncode, data["records"], proc.stderr[-1500:], images)

@@ -16,7 +16,8 @@ import numpy as np
 import pytest
 from PIL import Image, ImageSequence
 
-from conformance import animation, cli, scenes
+from conformance import cli, scenes
+from conformance.rendering import animation
 from conformance.rendering import outline
 from conformance.sync.printed import reproduce_command
 

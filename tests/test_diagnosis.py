@@ -132,7 +132,7 @@ def test_a_mistake_outside_the_catalogue_gets_no_diagnosis(spec, scene):
 
 def first_problem_diagnosis(spec, scene: str, frames: int, **params) -> tuple[int, str]:
     """The frame of the first problem of any kind ``check`` reports, and its diagnosis line."""
-    from conformance.animation import check_frame
+    from conformance.rendering.animation import check_frame
 
     with runner.running(scene, _implementation(spec), **params) as run:
         for frame in range(frames + 1):

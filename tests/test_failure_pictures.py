@@ -1,6 +1,6 @@
 """A failing vertex check shows in ``report.html``: the failing frame as the sync drew it, with the
 outline of where pyBullet has each failing body, its diagnosis and its ``reproduce:`` command
-(conformance.rendering.misplaced); a right sync's run has no such card."""
+(conformance.reports.misplaced); a right sync's run has no such card."""
 
 from __future__ import annotations
 

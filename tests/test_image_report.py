@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from conformance.errors import InvalidArgument
-from conformance.rendering import artefacts, report
+from conformance.reports import artefacts, report
 from conformance.rendering.records import ImageCheck
 
 W, H = 450, 384
@@ -229,7 +229,7 @@ def test_the_report_survives_missing_pictures_and_empty_runs_and_stays_in_its_di
 def test_a_screenshot_of_the_report(tmp_path, worker):
     from PIL import Image
 
-    from conformance.rendering.screenshot import screenshot
+    from conformance.reports.screenshot import screenshot
 
     page = report.write_report(demo_run(tmp_path, worker), tmp_path)
     png = screenshot(page, tmp_path / "shot.png", size=(800, 600))

@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from conformance import backends, cli, images
+from conformance import backends, cli
+from conformance.rendering import images
 from conformance.backends import display
 from conformance.errors import DisplayUnavailable
 from children import run as _run, said as _said

@@ -332,8 +332,8 @@ def check(judgement):
 def keep(verdict, results_dir, reproduce: str = "", nodeid: str = "", keep_passing: bool = False) -> list[str]:
     """Write each failing picture's three images (``fury_mask``, ``pybullet_mask``, ``mask_difference``)
     and every record under ``results_dir``, as the scene checks' silhouettes are
-    (:func:`conformance.rendering.artefacts.write_artefacts`); the paths written, relative to it."""
-    from conformance.rendering import artefacts
+    (:func:`conformance.reports.artefacts.write_artefacts`); the paths written, relative to it."""
+    from conformance.reports import artefacts
 
     written = []
     for record, images in verdict.pictures:

@@ -2,7 +2,7 @@
 frame and print each frame's worst error (what a failing check's "reproduce:" line runs).
 
 Replacing ``check`` with ``render`` and adding ``--gif OUT.gif`` makes the same replay an animation
-with the failing frames marked (the same frame check: :func:`conformance.animation.check_frame`)."""
+with the failing frames marked (the same frame check: :func:`conformance.rendering.animation.check_frame`)."""
 
 from __future__ import annotations
 
@@ -31,7 +31,7 @@ def run(args, extra) -> int:
     from conformance.sync import runner
     from conformance.judge import diagnosis
     from conformance.bullet import events
-    from conformance.animation import check_frame
+    from conformance.rendering.animation import check_frame
 
     spec = scenes.get(args.scene)
     frames = spec.steps if args.frames is None else validation.whole_number("--frames", args.frames,

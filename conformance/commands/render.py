@@ -79,7 +79,8 @@ def run(args, extra) -> int:
 
 def _validated(args) -> _Request:
     """Every argument checked, before the display starts or anything is written."""
-    from conformance import animation, scenes, sync
+    from conformance import scenes, sync
+    from conformance.rendering import animation
     from conformance.bullet import events
 
     names = scenes.names() if args.scene == ["all"] else args.scene
@@ -142,7 +143,7 @@ def _render_one(name: str, request: _Request) -> None:
 
 def _animate(request: _Request) -> int:
     """Exit status 0 when every pictured frame passes the check, 1 when any fails (as ``check``)."""
-    from conformance import animation
+    from conformance.rendering import animation
 
     name, frames = request.names[0], request.frames
     made = animation.record(name, request.implementation, frames, request.gif, size=request.size,

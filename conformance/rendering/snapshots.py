@@ -208,7 +208,8 @@ def regenerate(scene_name: str, directory: Path | str, *, mode: str = "all", tol
     (missing or unreadable), or ``failing`` (missing, unreadable, or failing the renderer verdict
     with the reference sync). A selected golden that differs only by float noise
     (:func:`only_float_noise`) is kept: neither file is touched."""
-    from conformance import images, scenes
+    from conformance import scenes
+    from conformance.rendering import images
 
     if mode not in ("all", "missing", "failing"):
         raise ValueError(f"mode={mode!r}, but should be 'all', 'missing' or 'failing'")

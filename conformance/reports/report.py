@@ -31,7 +31,7 @@ from pathlib import Path
 from typing import Any, Iterable
 
 from conformance.files import write_atomically
-from conformance.rendering.artefacts import ROLES, _jsonable
+from conformance.reports.artefacts import ROLES, _jsonable
 from conformance.rendering.records import KINDS, ImageCheck
 
 __all__ = ["render_report", "write_report"]
