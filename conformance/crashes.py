@@ -135,7 +135,7 @@ class Controller:
     def _report_row(self, crashitem: str, scene, step, message: str) -> None:
         """The crash as a row of ``report.html`` (kind ``crashed``, no pictures: the process that would
         have drawn them is gone), written by the controller, which outlives it."""
-        from conformance import image_options
+        from conformance.checks import image_options
         from conformance.reports import artefacts
         from conformance.rendering.records import ImageCheck
 

@@ -7,7 +7,7 @@ the checks that run a sync are put in the order of :data:`FIRST`, each over the 
 registered order: the pass-through scene and the golden render, which between them reject most
 mistakes soonest; the checks that build short runs of their own, about as cheap a scene (measured
 with ``--durations``); then the every-frame check, which pays for each scene's shared run
-(:mod:`conformance.shared_run`), and the checks after it, most of which read that run. Every other
+(:mod:`conformance.checks.shared_run`), and the checks after it, most of which read that run. Every other
 test keeps its place. Verdicts do not depend on the order: every check builds its own scenes.
 """
 

@@ -13,7 +13,7 @@ Options live under one group, each mirrored by an ini setting:
   of :mod:`conformance.judge.tolerances`.
 * ``--conformance-report PATH`` / ``conformance_report``: write every check's outcome, scene and
   worst measured error as JSON (what ``python -m conformance verdicts`` reads).
-* Pictures (:mod:`conformance.image_options` reads and validates them):
+* Pictures (:mod:`conformance.checks.image_options` reads and validates them):
   ``--conformance-golden-dir DIR`` / ``conformance_golden_dir`` (default: each scene's own goldens: the kit's, or golden/<backend>/ beside your scene file),
   ``--conformance-image-tolerance auto|same-renderer|other-renderer`` / ``conformance_image_tolerance``,
   ``--conformance-results DIR`` / ``conformance_results`` (failure pictures, records and the HTML report;
@@ -32,7 +32,7 @@ from collections import defaultdict
 
 import pytest
 
-from conformance import profiles
+from conformance.checks import profiles
 
 SYNC_OPTION = "--sync"
 _SYNC_KEY = pytest.StashKey["object"]()
@@ -93,7 +93,7 @@ def pytest_addoption(parser: pytest.Parser) -> None:
                     "conformance_scenes and $CONFORMANCE_SCENES")
     parser.addini("conformance_scenes", "your own scene sources (.py files relative to the ini file, or modules), "
                   "one per line", type="linelist", default=[])
-    from conformance import image_options
+    from conformance.checks import image_options
 
     image_options.add_options(group, parser)
     from conformance import selection
@@ -227,7 +227,7 @@ def pytest_configure(config: pytest.Config) -> None:
     named = bool(config.getoption("conformance_sync") or config.getini("conformance_sync") or ENV_VAR in os.environ)
     config.pluginmanager.register(selection.Selection(config, sync_named=named), "conformance-selection")
     if not hasattr(config, "workerinput"):
-        from conformance import image_options
+        from conformance.checks import image_options
 
         image_options.from_config(config).start_session()
 
@@ -290,7 +290,8 @@ def pytest_report_header(config: pytest.Config) -> list[str]:
             versions.append(f"{dist} {md.version(dist)}")
         except md.PackageNotFoundError:
             versions.append(f"{dist} missing")
-    from conformance import backends, image_options
+    from conformance import backends
+    from conformance.checks import image_options
     from conformance.errors import BackendError
 
     try:
@@ -368,7 +369,7 @@ def sync_implementation(request: pytest.FixtureRequest):
 @pytest.fixture(scope="session")
 def pictures(request: pytest.FixtureRequest):
     """Where goldens are read and failure pictures written, and the image tolerance in force."""
-    from conformance import image_options
+    from conformance.checks import image_options
 
     return image_options.from_config(request.config)
 
@@ -376,7 +377,7 @@ def pictures(request: pytest.FixtureRequest):
 @pytest.fixture
 def kit(request: pytest.FixtureRequest, sync_implementation):
     """The sync under test, the tolerances in force, and a recorder for this check's worst error."""
-    from conformance.pytest_helpers import Kit
+    from conformance.checks.pytest_helpers import Kit
 
     return Kit(sync_implementation, tolerance_from(request.config), request.node)
 
@@ -404,7 +405,7 @@ def pytest_runtest_call(item: pytest.Item):
 @pytest.hookimpl(wrapper=True, tryfirst=True)  # outermost: after Hypothesis' wrapper has added its patch
 def pytest_runtest_makereport(item: pytest.Item, call):
     report = yield
-    from conformance import survey
+    from conformance.checks import survey
 
     if _is_the_kits(item):
         # Hypothesis offers a patch "to add failing test cases to your code" for every failing draw, even
@@ -415,7 +416,7 @@ def pytest_runtest_makereport(item: pytest.Item, call):
     _only_the_paragraph(call, report)
     survey.settle(item, report)  # survey mode: a check that noted failures fails now, naming every kind
     if report.when == "call":
-        from conformance import image_options
+        from conformance.checks import image_options
         from conformance.reports import misplaced
 
         misplaced.keep(item, report, image_options.from_config(item.config))
@@ -493,7 +494,7 @@ class _Records:
 def pytest_sessionfinish(session: pytest.Session, exitstatus) -> None:
     if hasattr(session.config, "workerinput"):  # under xdist, only the controller writes the page and the JSON
         return
-    from conformance import image_options
+    from conformance.checks import image_options
 
     image_options.from_config(session.config).write_report(_sync_spec(session.config))
     path = _option(session.config, "report")
@@ -567,7 +568,7 @@ def _scene_verdict(outcomes: dict, selected: int | None, stopped: bool) -> tuple
 
 
 def pytest_terminal_summary(terminalreporter, exitstatus, config: pytest.Config) -> None:
-    from conformance import image_options
+    from conformance.checks import image_options
 
     image_options.from_config(config).summarize(terminalreporter)
     verdicts = config.stash.get(_VERDICT_KEY, None)

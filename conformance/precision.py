@@ -175,7 +175,7 @@ def pytest_args(seed: int, select: str = "") -> list[str]:
 
 def rerun_command(spec: str, seed: int, factor: int, nodeid: str = "") -> str:
     """The command that replays one process's draws (and, with ``nodeid``, only that check)."""
-    from conformance.profiles import DRAW_FACTOR
+    from conformance.checks.profiles import DRAW_FACTOR
 
     select = ["-k", nodeid.split("::", 1)[-1]] if nodeid else []
     from conformance.sync import printed
@@ -191,7 +191,7 @@ def sync_draws(specs, seeds, *, factor: int, select: str = "", jobs: int | None 
     import os
 
     from conformance import verdicts
-    from conformance.profiles import DRAW_FACTOR
+    from conformance.checks.profiles import DRAW_FACTOR
 
     env = {**os.environ, DRAW_FACTOR: str(factor)}
 

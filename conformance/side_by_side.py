@@ -34,7 +34,7 @@ from conformance.sync import runner
 from conformance.judge import compare
 from conformance.bullet import truth
 from conformance.errors import SyncError
-from conformance.survey import times
+from conformance.checks.survey import times
 from conformance.judge.tolerances import DEFAULT, Tolerance
 
 __all__ = ["Judgement", "SceneComparison", "TargetComparison", "compare_scene", "verdict"]

@@ -66,7 +66,7 @@ def test_app(app, check, request, pictures):
 def test_app_perturbed(app, request, pictures):
     """The app passes every check when the kit turns, kicks and resets its bodies between ticks: a sync
     right only for the motions the app happens to produce fails here."""
-    from conformance import profiles
+    from conformance.checks import profiles
     from conformance.plugin import tolerance_from
 
     own = _own_run(request.config, app)

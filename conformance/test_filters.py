@@ -29,16 +29,16 @@ from conformance.bullet.collisions import (
     pair_of,
 )
 from conformance.bullet.deviations import NO_SHRINK, expected_failure
-from conformance.physics_assertions import (
+from conformance.checks.physics_assertions import (
     assert_collision,
     assert_drawn_overlapping,
     assert_interpenetrating,
     context,
 )
-from conformance.profiles import check_settings
-from conformance.pytest_helpers import assert_vertices_match, sync_run
+from conformance.checks.profiles import check_settings
+from conformance.checks.pytest_helpers import assert_vertices_match, sync_run
 from conformance.scenes.crossing import Timeline
-from conformance.strategies import (
+from conformance.checks.strategies import (
     crossing_parameters,
     filter_modes,
     group_masks,

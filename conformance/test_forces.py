@@ -19,9 +19,9 @@ from hypothesis import example, given, settings, strategies as st
 from conformance import scenes
 from conformance.bullet.deviations import NO_SHRINK, expected_failure
 from conformance.bullet.physics import Push, base_state, expected_push, solid_inertia
-from conformance.physics_assertions import assert_close, assert_vector_close, context
-from conformance.profiles import check_settings
-from conformance.strategies import (
+from conformance.checks.physics_assertions import assert_close, assert_vector_close, context
+from conformance.checks.profiles import check_settings
+from conformance.checks.strategies import (
     force_frames,
     forces,
     free_bodies,

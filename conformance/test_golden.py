@@ -32,7 +32,7 @@ import pytest
 
 from conformance import scenes
 from conformance.errors import GoldenError
-from conformance.pytest_helpers import each_golden_variant, each_scene, variant_id
+from conformance.checks.pytest_helpers import each_golden_variant, each_scene, variant_id
 
 
 def _reproduce(check: str, scene: str, sync: str, variant: dict | None = None, pictures=None) -> str:

@@ -24,10 +24,10 @@ from conformance.bullet.physics import (
     landing_height,
     sliding_deceleration,
 )
-from conformance.physics_assertions import assert_close, assert_in_band, assert_vector_close, context
-from conformance.profiles import check_settings
+from conformance.checks.physics_assertions import assert_close, assert_in_band, assert_vector_close, context
+from conformance.checks.profiles import check_settings
 from conformance.scenes import Shape
-from conformance.strategies import (
+from conformance.checks.strategies import (
     damping_factors,
     free_bodies,
     landing_steps,

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from conformance import backends
 from conformance.rendering import images
-from conformance.pytest_helpers import each_scene, sync_run
+from conformance.checks.pytest_helpers import each_scene, sync_run
 
 
 @each_scene()

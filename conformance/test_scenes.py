@@ -8,12 +8,13 @@ import pybullet
 import pytest
 from hypothesis import given
 
-from conformance import backends, determinism, scenes
+from conformance import backends, scenes
+from conformance.checks import determinism
 from conformance.judge import compare
 from conformance.errors import InvalidArgument
 from conformance.implementations.reference import ReferenceSync
-from conformance.profiles import check_settings
-from conformance.pytest_helpers import assert_geometry_matches, each_scene
+from conformance.checks.profiles import check_settings
+from conformance.checks.pytest_helpers import assert_geometry_matches, each_scene
 
 
 def _open_clients() -> set[int]:

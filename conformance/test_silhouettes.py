@@ -12,10 +12,11 @@ from __future__ import annotations
 import pytest
 from hypothesis import given, strategies as st
 
-from conformance import backends, image_options, scenes, shared_run, strategies
+from conformance import backends, scenes
+from conformance.checks import image_options, shared_run, strategies
 from conformance.bullet.events import Teleport
-from conformance.profiles import check_settings
-from conformance.pytest_helpers import _context, each_scene
+from conformance.checks.profiles import check_settings
+from conformance.checks.pytest_helpers import _context, each_scene
 from conformance.rendering import framing, golden, silhouettes
 
 def assert_passed(record, run, sync: str) -> None:
@@ -52,7 +53,7 @@ def _silhouettes(run, kit):
 @each_scene()
 def test_silhouettes_match_pybullet_at_golden_frames(scene_name, kit, pictures, request):
     """Each target's FURY silhouette overlaps pyBullet's at the first, middle and last golden frame
-    (of the scene's shared run, :mod:`conformance.shared_run`)."""
+    (of the scene's shared run, :mod:`conformance.checks.shared_run`)."""
     check = "test_silhouettes_match_pybullet_at_golden_frames"
     for record, images in shared_run.seen(kit, check, scene_name).get(_SEEN, ()):
         record.nodeid = request.node.nodeid

@@ -21,10 +21,10 @@ import pytest
 from hypothesis import settings, strategies as st
 from hypothesis.stateful import RuleBasedStateMachine, initialize, invariant, precondition, rule, run_state_machine_as_test
 
-from conformance import profiles, strategies, survey
+from conformance.checks import profiles, strategies, survey
 from conformance.bullet.events import JointReset, Kick, Teleport
-from conformance.profiles import check_settings, stateful_steps
-from conformance.pytest_helpers import VERTEX_TARGET, Kit, _context
+from conformance.checks.profiles import check_settings, stateful_steps
+from conformance.checks.pytest_helpers import VERTEX_TARGET, Kit, _context
 
 #: Scenes with a multibody's links (pendulum, wrecking_ball), shared actors (domino, wrecking_ball),
 #: static bodies (all four) and bases with an inertial offset (weighted).

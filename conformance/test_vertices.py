@@ -13,12 +13,13 @@ import numpy as np
 import pytest
 from hypothesis import example, given, strategies as st
 
-from conformance import backends, figures, profiles, scenes, shared_run, strategies
+from conformance import backends, figures, scenes
+from conformance.checks import profiles, shared_run, strategies
 from conformance.judge import compare
 from conformance.bullet.events import turning_everything
-from conformance.profiles import check_settings
+from conformance.checks.profiles import check_settings
 from conformance.sync.printed import rerun_check
-from conformance.pytest_helpers import _context, bounds_figure, each_scene
+from conformance.checks.pytest_helpers import _context, bounds_figure, each_scene
 
 
 def _scene_runs(scene_name: str, longest: int):
@@ -97,7 +98,7 @@ def _every_frame(run, kit):
 def test_vertices_match_poses_every_frame(scene_name, kit):
     """The scene with its own parameters (the guide's, for the guide's scenes), then with each of its
     ``examples``: every target, every frame of the default run, from frame 0 (right after set-up) on.
-    (The default run is the scene's shared run, :mod:`conformance.shared_run`.)"""
+    (The default run is the scene's shared run, :mod:`conformance.checks.shared_run`.)"""
     spec = scenes.get(scene_name)
     shared_run.report(kit, "test_vertices_match_poses_every_frame", scene_name)
     for params in spec.examples:

@@ -5,7 +5,7 @@ that writes a JSON report (``--conformance-report``) and keeps its pictures in a
 its own; this module reads the reports and renders markdown: a scene × implementation table, a
 property × implementation table, and why each implementation failed. It also computes the kill rate
 of a set of deliberately wrong implementations. No pytest run here: the plugin writes the records,
-this module only reads them (:mod:`conformance.survey` is where both agree on kinds and figures).
+this module only reads them (:mod:`conformance.checks.survey` is where both agree on kinds and figures).
 
 ``verdicts`` runs in survey mode (``--conformance-survey``): every check runs every frame and its
 record names every *kind* of failure it found (vertices, normals, Modified, bounds, …) with the
@@ -23,7 +23,7 @@ import tempfile
 from concurrent.futures import ThreadPoolExecutor, as_completed
 from dataclasses import dataclass, field
 
-from conformance import survey
+from conformance.checks import survey
 from conformance.progress import progress
 
 __all__ = ["Outcome", "check", "check_all", "command", "current_label", "implementations", "kill_rate_beside", "kill_rate_table", "load_run",

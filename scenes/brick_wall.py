@@ -79,7 +79,7 @@ SPEC = SceneSpec(
     populate=populate,
     camera=Camera((10.46, -8.13, 6.18), (0.0, 0.0, 0.79), (-0.27, 0.26, 0.9), view_angle=30.0, clipping_range=(0.5, 20.0)),
     steps=131,
-    # Measured with conformance.determinism.first_divergence: a 1 nm nudge of every body exceeds the physics
+    # Measured with conformance.checks.determinism.first_divergence: a 1 nm nudge of every body exceeds the physics
     # verdict's tolerance after step 2 (bricks resting on bricks).
     chaotic_after=2,
     origin="guide",

@@ -117,7 +117,7 @@ SPEC = SceneSpec(
     camera=Camera((6.93, -8.72, 5.47), (-0.24, -0.11, 1.31), (0.0, 0.0, 1.0), view_angle=30.0, clipping_range=(0.5, 20.0)),
     # 1.5 s: everything has landed (the highest start falls in ~0.7 s) and is tumbling or settling.
     steps=360,
-    # Measured with conformance.determinism.first_divergence: a 1 nm nudge of every body exceeds the physics
+    # Measured with conformance.checks.determinism.first_divergence: a 1 nm nudge of every body exceeds the physics
     # verdict's tolerance after step 153 (bodies tumbling into a pile).
     chaotic_after=153,
     origin="canonical",

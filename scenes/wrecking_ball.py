@@ -106,7 +106,7 @@ SPEC = SceneSpec(
     steps=131,
     origin="guide",
     poster_step=45,
-    # Measured with conformance.determinism.first_divergence: a 1 nm nudge of every body exceeds the physics
+    # Measured with conformance.checks.determinism.first_divergence: a 1 nm nudge of every body exceeds the physics
     # verdict's tolerance after step 1 (bricks resting on bricks; the ball's whip later).
     chaotic_after=1,
     description="A 5 kg ball on a 15-link chain pinned at z = 2, its hinge pushed once, smashes a 5×5×5 brick block.",

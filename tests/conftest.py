@@ -5,7 +5,7 @@ before pytester snapshots ``sys.modules``."""
 import conformance.cli  # noqa: F401
 import conformance.judge.compare  # noqa: F401
 import conformance.implementations.guide  # noqa: F401
-import conformance.pytest_helpers  # noqa: F401
+import conformance.checks.pytest_helpers  # noqa: F401
 import conformance.sync.runner  # noqa: F401
 import conformance.test_scenes  # noqa: F401
 import conformance.test_vertices  # noqa: F401

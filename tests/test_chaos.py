@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from conformance import determinism, scenes
+from conformance import scenes
+from conformance.checks import determinism
 from conformance.bullet import state
 
 

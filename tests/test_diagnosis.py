@@ -175,7 +175,7 @@ def test_wrong_normals_outside_the_catalogue_get_no_diagnosis():
 
 def test_the_diagnosis_is_under_the_failure_of_a_check_and_of_check(capsys):
     from conformance.commands import check
-    from conformance.pytest_helpers import assert_vertices_match
+    from conformance.checks.pytest_helpers import assert_vertices_match
 
     with runner.running("free_fall", sync.load("wrong_syncs:OneStepLate")) as run:
         run.advance(5)

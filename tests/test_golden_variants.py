@@ -15,7 +15,7 @@ import pytest
 from conformance import backends, scenes, sync
 from conformance.sync import runner
 from conformance.errors import InvalidArgument
-from conformance.pytest_helpers import variant_id
+from conformance.checks.pytest_helpers import variant_id
 from conformance.rendering import compare, golden, snapshots
 from conformance.scenes import SceneSpec
 

@@ -15,7 +15,7 @@ from hypothesis import settings
 
 from conformance import sync, verdicts
 from conformance import test_sync_order as order
-from conformance.pytest_helpers import Kit
+from conformance.checks.pytest_helpers import Kit
 from conformance.judge.tolerances import DEFAULT
 
 RIGHT = ["reference", *verdicts.implementations("right_syncs")]

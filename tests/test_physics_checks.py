@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 
-from conformance import documented, strategies, sync
+from conformance import sync
+from conformance.checks import documented, strategies
 from conformance.bullet import collisions, deviations, physics
 from conformance import test_filters as filters
 from conformance import test_forces as forces

@@ -11,7 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from conformance import figures, precision, profiles
+from conformance import figures, precision
+from conformance.checks import profiles
 
 TESTS = Path(__file__).resolve().parent
 
@@ -146,7 +147,7 @@ def test_a_band_s_figure_is_measured_from_the_law_s_value():
     band's far edge is still 100 %. Outside the band the assertion fails as before."""
     import pytest as _pytest
 
-    from conformance.physics_assertions import assert_in_band
+    from conformance.checks.physics_assertions import assert_in_band
 
     def use(actual, **band):
         with figures.tally() as noted:

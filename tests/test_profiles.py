@@ -9,7 +9,7 @@ import pytest
 
 PROPERTY = """
 from hypothesis import given, strategies as st
-from conformance.profiles import check_settings
+from conformance.checks.profiles import check_settings
 
 # Computed, never a literal: Hypothesis draws the integer literals of the source it imports (about 4 runs
 # in 60 drew 1000 itself when this read `x < 1000`), and an unshrunk run would then report the limit.
@@ -40,8 +40,9 @@ def test_each_example_reports_how_close_it_came_to_failing(monkeypatch):
     for the reference, a real fraction for float32 increments; never from outside an example, never a NaN."""
     from hypothesis import given, settings, strategies as st
 
-    from conformance import profiles, sync
-    from conformance.pytest_helpers import VERTEX_TARGET, Kit
+    from conformance import sync
+    from conformance.checks import profiles
+    from conformance.checks.pytest_helpers import VERTEX_TARGET, Kit
     from conformance.test_vertices import check_run
     from conformance.judge.tolerances import DEFAULT
 

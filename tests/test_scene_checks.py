@@ -6,7 +6,8 @@ import pybullet
 import pytest
 
 import bad_scenes
-from conformance import determinism, scenes
+from conformance import scenes
+from conformance.checks import determinism
 from conformance import test_scenes as checks
 
 Failed = pytest.fail.Exception

@@ -1,4 +1,4 @@
-"""The shared run (:mod:`conformance.shared_run`) in a real session: the checks that watch one run of
+"""The shared run (:mod:`conformance.checks.shared_run`) in a real session: the checks that watch one run of
 a scene each keep their own verdict, and a sync that raises fails every one of them with its paragraph.
 Each case is pytest on the kit, as a user runs it (``verdicts.check``, records read back)."""
 

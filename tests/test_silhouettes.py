@@ -159,7 +159,7 @@ def test_touching_pairs_are_bodies_in_contact():
     """A cylinder sunk into the ground (the case the orientation property once failed a right sync on)
     is in contact with it; two spheres half a metre apart are not."""
     from conformance.bullet import events
-    from conformance.pytest_helpers import sync_run
+    from conformance.checks.pytest_helpers import sync_run
 
     turn = events.loads('[{"kind":"teleport","frame":0,"which":0,"offset":[0.0,0.0,0.0],'
                         '"orientation":[0.7071067811865476,4.329780281177467e-17,0.0,0.7071067811865476]}]')

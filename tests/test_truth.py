@@ -6,7 +6,7 @@ import numpy as np
 import pybullet
 from hypothesis import given, settings, strategies as st
 
-from conformance import strategies
+from conformance.checks import strategies
 from conformance.bullet import truth
 from conformance.bullet.client import BoundClient
 

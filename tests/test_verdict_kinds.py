@@ -18,9 +18,10 @@ from pathlib import Path
 import pytest
 
 import wrong_syncs
-from conformance import backends, survey, sync, verdicts
+from conformance import backends, sync, verdicts
+from conformance.checks import survey
 from conformance import test_vertices as checks
-from conformance.pytest_helpers import Kit
+from conformance.checks.pytest_helpers import Kit
 from conformance.judge.tolerances import DEFAULT
 
 Failed = pytest.fail.Exception

@@ -17,8 +17,8 @@ from conformance import backends, sync
 from conformance.judge import compare
 from conformance import test_vertices as checks
 from conformance.bullet.events import Teleport
-from conformance.pytest_helpers import Kit
-from conformance.strategies import HARD_ORIENTATIONS
+from conformance.checks.pytest_helpers import Kit
+from conformance.checks.strategies import HARD_ORIENTATIONS
 from conformance.judge.tolerances import DEFAULT
 
 Failed = pytest.fail.Exception

@@ -8,7 +8,7 @@ sync has to draw poses its story never produces. Every event is applied on every
 app that has bodies (an app may keep an empty client, or one per world). Events name bodies by position
 in the list of a client's *dynamic* bodies (``which`` modulo its length; static bodies are left where the app put them,
 so an app may draw them as part of the world) and joints by position in the list of movable joints,
-and are drawn by Hypothesis (:func:`conformance.strategies.app_events`), so a failure is reproducible from its JSON.
+and are drawn by Hypothesis (:func:`conformance.checks.strategies.app_events`), so a failure is reproducible from its JSON.
 
 An event wrapped in :class:`AfterStep` is applied instead right after the first ``stepSimulation`` of its
 tick, before the app's sync reads: a body teleported there is at rest when the sync runs

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from hypothesis import HealthCheck, Phase, given, settings
 
-from conformance import strategies
+from conformance.checks import strategies
 
 __all__ = ["opening", "search"]
 

@@ -11,7 +11,7 @@ bullet3's master branch, and the upstream issues are open); when a release fixes
 range below that release.
 
 ``python -m conformance documented`` measures every documented statement the checks rely on, these
-included, on the installed pybullet and prints the table (``conformance.documented``).
+included, on the installed pybullet and prints the table (``conformance.checks.documented``).
 """
 
 from __future__ import annotations

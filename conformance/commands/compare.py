@@ -212,7 +212,7 @@ def passed(results) -> bool:
 
 def summary(results) -> str:
     """The overall verdict: both agree everywhere, or which side does not agree, on which scenes, how badly."""
-    from conformance import survey
+    from conformance.checks import survey
 
     if not results:
         return "nothing compared"

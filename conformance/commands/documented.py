@@ -14,7 +14,7 @@ def add_arguments(parser) -> None:
 
 
 def run(args, extra) -> int:
-    from conformance import documented
+    from conformance.checks import documented
 
     emit(documented.table(), args.out)
     return 0

@@ -30,7 +30,8 @@ def measure(scene_names, draws: int, seed: int = 0, keep=None) -> list[dict]:
     from hypothesis import HealthCheck, Phase, given, settings, strategies as st
     from hypothesis import seed as seeded
 
-    from conformance import backends, scenes, strategies, sync
+    from conformance import backends, scenes, sync
+    from conformance.checks import strategies
     from conformance.sync import runner
     from conformance.bullet.events import turning_everything
     from conformance.rendering import silhouettes

@@ -70,7 +70,7 @@ def note(node, run, failures: Sequence[Any], worst, *, sync: str, message: str, 
 
 def keep(item, report, pictures) -> None:
     """Write the picture :func:`note` kept on ``item`` when its call ``report`` failed (``pictures``:
-    the session's :class:`conformance.image_options.Pictures`); forget it either way."""
+    the session's :class:`conformance.checks.image_options.Pictures`); forget it either way."""
     kept = item.stash.get(PICTURE, None)
     if kept is None:
         return

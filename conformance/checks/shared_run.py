@@ -10,7 +10,7 @@ check then reports what its own watcher saw (:func:`report`), as it would have a
 mode its first failure, in survey mode every kind with its worst figure. The verdicts are the same
 as before: each watcher sees the same frames, drawn by a sync called the same way, in the same order.
 
-A watcher records through a :class:`~conformance.pytest_helpers.Kit` of its own, in survey mode, so
+A watcher records through a :class:`~conformance.checks.pytest_helpers.Kit` of its own, in survey mode, so
 nothing it finds stops the others; a sync that raises stops the run, and every check that shares it
 fails with the same paragraph. Only watchers whose check is selected for the scene in this session
 run (``-k`` narrows the shared run too). Under pytest-xdist each worker keeps its own shared runs, so
@@ -26,7 +26,8 @@ from typing import Any, Callable
 
 import pytest
 
-from conformance import scenes, survey as survey_module
+from conformance import scenes
+from conformance.checks import survey as survey_module
 from conformance.reports import misplaced
 from conformance.errors import SyncError
 
@@ -71,7 +72,7 @@ def _selected(session, scene: str) -> list[Watcher]:
 def _run(kit, scene: str, watchers: list[Watcher], config) -> dict[str, Any]:
     """Step ``scene`` once with the kit's sync; each watcher records into a survey-mode Kit of its own
     (whose ``_node`` has a ``stash`` dict and the session's ``config``)."""
-    from conformance.pytest_helpers import Kit
+    from conformance.checks.pytest_helpers import Kit
 
     spec = scenes.get(scene)
     seen = {w.check: SimpleNamespace(stash={}, config=config) for w in watchers}
@@ -129,7 +130,7 @@ def report(kit, check: str, scene: str) -> None:
 
 def _replay(kit, stash: dict) -> None:
     __tracebackhide__ = True
-    from conformance.pytest_helpers import WORST
+    from conformance.checks.pytest_helpers import WORST
 
     node = kit._node
     worst = stash.get(WORST)

@@ -13,7 +13,7 @@ measurement with the deviation list (``conformance.bullet.deviations``):
   expected failure turns into a failure as well) — narrow its range;
 * ``not documented (measured)``: the documents are silent; the kit relies on the measured value.
 
-``python -m conformance documented`` prints :func:`table` (``python -m conformance.documented``
+``python -m conformance documented`` prints :func:`table` (``python -m conformance.checks.documented``
 works as well).
 """
 

@@ -4,7 +4,7 @@ helpers with readable messages.
 Messages follow array-api-tests: ``x=…, but should be … [scene(params), frame]``, followed by a
 command that reproduces the failure.
 
-Two modes (:mod:`conformance.survey`): by default an assertion fails the check at its first failing
+Two modes (:mod:`conformance.checks.survey`): by default an assertion fails the check at its first failing
 frame; in survey mode (``--conformance-survey``) :class:`Kit` notes each failure by kind, with the
 same message, and the check runs on and fails at its end with every kind it found.
 """
@@ -18,11 +18,12 @@ from typing import Any, Callable, Iterable, Iterator, Mapping, Sequence
 
 import pytest
 
-from conformance import figures, profiles, scenes, survey as survey_module
+from conformance import figures, scenes
+from conformance.checks import profiles, survey as survey_module
 from conformance.judge import compare, diagnosis
 from conformance.bullet import events as events_module
 from conformance.errors import SyncError
-from conformance.survey import WORST  # noqa: F401  (where the plugin and older callers find it)
+from conformance.checks.survey import WORST  # noqa: F401  (where the plugin and older callers find it)
 from conformance.sync.printed import reproduce_command
 from conformance.judge.tolerances import Tolerance
 
@@ -185,7 +186,7 @@ class Kit:
     Default mode: :meth:`assert_frame` and :meth:`fail` raise at the first failure, with the messages
     the ``assert_*`` helpers give. Survey mode (``survey=True``, or ``--conformance-survey`` for the
     fixture): they note each failure in :attr:`survey` by kind and return, so the check runs every
-    frame it would have run; the plugin fails the check at its end (:func:`conformance.survey.settle`),
+    frame it would have run; the plugin fails the check at its end (:func:`conformance.checks.survey.settle`),
     or call :meth:`finish`."""
 
     def __init__(self, implementation, tolerance: Tolerance, node: pytest.Item | None = None,
@@ -215,7 +216,7 @@ class Kit:
     @contextlib.contextmanager
     def aiming(self, label: str = VERTEX_TARGET) -> Iterator[None]:
         """Around one Hypothesis example: the worst vertex error it saw, in tolerances, becomes its
-        ``hypothesis.target`` (:func:`conformance.profiles.aim`) when it ends without failing."""
+        ``hypothesis.target`` (:func:`conformance.checks.profiles.aim`) when it ends without failing."""
         self.closest = 0.0
         yield
         profiles.aim(self.closest, label)
@@ -292,10 +293,10 @@ class Kit:
         misplaced.note(self._node, run, failures, worst, sync=self.sync, message=message, first=self.survey is not None)
 
     def fail(self, kind: str, message: str, *, exception: type[BaseException] | None = None, **numbers: Any) -> None:
-        """A failure of ``kind`` (:data:`conformance.survey.KINDS`) that a check found: raised now in
+        """A failure of ``kind`` (:data:`conformance.checks.survey.KINDS`) that a check found: raised now in
         default mode (``pytest.fail(message)``, or ``exception(message)`` for a check that has always
         failed with that type), noted in survey mode with ``numbers`` (``value``, ``limit``, ``unit``,
-        ``frame``, ``target``, as :func:`conformance.survey.figure` takes them)."""
+        ``frame``, ``target``, as :func:`conformance.checks.survey.figure` takes them)."""
         __tracebackhide__ = True
         self._failed(kind, message, exception=exception, **numbers)
 

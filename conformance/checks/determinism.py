@@ -48,7 +48,7 @@ def digests_in_subprocess(names: list[str], steps: int | None = None) -> dict[st
         "names, steps, modules, path = json.loads(sys.argv[1])\n"
         "sys.path[:0] = [p for p in path if p not in sys.path]\n"
         "from conformance import scenes\n"
-        "from conformance.determinism import digest\n"
+        "from conformance.checks.determinism import digest\n"
         "found = {s.name: s for m in modules for s in vars(importlib.import_module(m)).values()\n"
         "         if isinstance(s, scenes.SceneSpec)}\n"
         "found.update(scenes.SCENES)\n"

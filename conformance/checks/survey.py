@@ -54,7 +54,7 @@ WORST_NORMALS = pytest.StashKey[dict]()
 #: The survey of a check running in survey mode.
 SURVEY = pytest.StashKey["Survey"]()
 
-#: The kind and figure of the failure a :class:`~conformance.pytest_helpers.Kit` raised last (default mode).
+#: The kind and figure of the failure a :class:`~conformance.checks.pytest_helpers.Kit` raised last (default mode).
 RAISED = pytest.StashKey[dict]()
 #: Set on an item whose passing call report :func:`settle` turned into a failure.
 _SETTLED = pytest.StashKey[str]()
@@ -291,7 +291,7 @@ def _image_figures(item, report) -> dict[str, dict[str, Any]]:
     """The worst failed image check of this check (golden render, silhouette), from the records the
     image checks keep in the results directory: their measured numbers, frame by frame."""
     try:
-        from conformance import image_options
+        from conformance.checks import image_options
         from conformance.reports import artefacts
 
         records = artefacts.read_records(image_options.from_config(item.config).results)
