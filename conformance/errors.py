@@ -79,7 +79,7 @@ class SyncTimedOut(SyncError):
 
 class SyncCrashed(SyncError):
     """The sync implementation crashed the process (a signal, ``os._exit``) on this scene earlier in the
-    run, so a check that would run it there again fails at once (:mod:`conformance.crashes`)."""
+    run, so a check that would run it there again fails at once (:mod:`conformance.session.isolation`)."""
 
 
 class GoldenError(ConformanceError):

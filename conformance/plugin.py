@@ -7,7 +7,7 @@ Options live under one group, each mirrored by an ini setting:
 * ``--conformance-sync-timeout SECONDS`` / ``conformance_sync_timeout``: the longest one call into the
   sync may take (default 10 s, 0 for none; :mod:`conformance.sync.time_limit`).
 * ``--conformance-isolation auto|process|none`` / ``conformance_isolation``: whether a serial run goes to
-  one worker process, so that a sync that crashes the interpreter fails its checks (:mod:`conformance.crashes`).
+  one worker process, so that a sync that crashes the interpreter fails its checks (:mod:`conformance.session.isolation`).
 * ``--conformance-size-rtol``, ``--conformance-position-rtol``, ``--conformance-atol``,
   ``--conformance-normal-angle`` (and ``conformance_size_rtol`` … in the ini file): the tolerances
   of :mod:`conformance.judge.tolerances`.
@@ -96,7 +96,7 @@ def pytest_addoption(parser: pytest.Parser) -> None:
     from conformance.checks import image_options
 
     image_options.add_options(group, parser)
-    from conformance import selection
+    from conformance.session import selection
 
     selection.add_options(group)
 
@@ -195,9 +195,9 @@ def load_own_scenes(config: pytest.Config) -> None:
 @pytest.hookimpl(wrapper=True)
 def pytest_cmdline_main(config: pytest.Config):
     """Before pytest-xdist reads ``-n``: a serial run whose sync may crash goes to one worker process."""
-    from conformance import crashes
+    from conformance.session import isolation
 
-    crashes.arrange(config, _sync_spec(config), _option(config, "isolation") or "auto")
+    isolation.arrange(config, _sync_spec(config), _option(config, "isolation") or "auto")
     return (yield)
 
 
@@ -216,12 +216,12 @@ def pytest_configure(config: pytest.Config) -> None:
     # -n keeps pytest-xdist's default scheduling. Grouping a scene's checks on one worker
     # ("loadgroup") would spare a second worker stepping the same scene, but xdist 3.8 applies groups
     # only when --dist loadgroup is on the command line its workers re-read, and its group scheduler
-    # stalls after a worker crashes (conformance.crashes), so the kit no longer asks for it;
+    # stalls after a worker crashes (conformance.session.isolation), so the kit no longer asks for it;
     # --dist loadgroup given by the user still groups by the marks added below.
     config.pluginmanager.register(_Records(config), "conformance-records")
     import os
 
-    from conformance import selection
+    from conformance.session import selection
     from conformance.sync import ENV_VAR
 
     named = bool(config.getoption("conformance_sync") or config.getini("conformance_sync") or ENV_VAR in os.environ)
@@ -237,7 +237,7 @@ def _watch_for_crashes(config: pytest.Config) -> None:
     and the sync loaded and the options read once here too, so that a sync that cannot be loaded or a
     bad value is the usual one-paragraph usage error rather than a worker's internal error (workers
     start their journal at ``pytest_sessionstart``)."""
-    from conformance import crashes
+    from conformance.session import isolation
 
     if hasattr(config, "workerinput"):
         return
@@ -245,11 +245,11 @@ def _watch_for_crashes(config: pytest.Config) -> None:
         return
     from conformance import scenes
 
-    crashes.allow_restarts(config, len(scenes.names()))
+    isolation.allow_restarts(config, len(scenes.names()))
     spec = _sync_spec(config)
     seconds = _option(config, "sync_timeout")  # a bad value: the usage error, here, once
     tolerance_from(config)
-    config.pluginmanager.register(crashes.Controller(config, spec, _RECORD_PROPERTY, seconds), "conformance-crashes")
+    config.pluginmanager.register(isolation.Controller(config, spec, _RECORD_PROPERTY, seconds), "conformance-crashes")
     from conformance.implementations import SHORT_NAMES
 
     if spec not in SHORT_NAMES:
@@ -318,7 +318,7 @@ def pytest_report_header(config: pytest.Config) -> list[str]:
 def pytest_collection_modifyitems(session: pytest.Session, config: pytest.Config, items) -> None:
     """Mark the checks that run the sync under test (``-m sync`` selects them) and load the sync once,
     before any check runs, if any collected check needs it."""
-    from conformance import ordering
+    from conformance.session import ordering
 
     placeholders = [item for item in items if getattr(item, "callspec", None) is not None
                     and "app" in item.callspec.params and item.callspec.params["app"] is None]

@@ -79,7 +79,7 @@ MAX_JOBS = 256
 #: The environment variable that names the sync when neither --sync nor the ini does (``conformance.sync.ENV_VAR``).
 SYNC_ENV_VAR = "CONFORMANCE_SYNC"
 DEFAULT_SYNC = "reference"
-#: ``--conformance-isolation``: a serial run in a worker process of its own (``conformance.crashes``).
+#: ``--conformance-isolation``: a serial run in a worker process of its own (``conformance.session.isolation``).
 ISOLATION_CHOICES = ("auto", "process", "none")
 
 IMAGE_TOLERANCE_CHOICES = ("auto", "same-renderer", "other-renderer")

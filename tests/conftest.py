@@ -56,7 +56,7 @@ def pytest_report_header(config):
     """The seed of this run's random-draw slice (``tests/test_random_draws.py``), and how to replay it."""
     from pathlib import Path
 
-    from conformance import precision
+    from conformance.discrimination import precision
 
     seed, source = precision.draw_seed(Path(__file__).resolve().parent.parent)
     return [f"random-draw slice: seed {seed} (from {source}; {precision.SEED_VARIABLE}={seed} replays it)"]

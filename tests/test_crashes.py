@@ -1,5 +1,5 @@
 """A sync that kills the interpreter fails the checks it crashed, and the run completes the others,
-serially too: :mod:`conformance.crashes` (issue: syncs that hang or crash)."""
+serially too: :mod:`conformance.session.isolation` (issue: syncs that hang or crash)."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from conformance import crashes
+from conformance.session import isolation
 
 from crashing_syncs import CALL, SCENE
 
@@ -138,7 +138,7 @@ def test_an_isolation_that_is_not_a_choice_is_refused(pytester):
 
 
 def test_the_crashed_checks_words_select_it_again():
-    assert crashes._test_words("test_vertices.py::test_sync_keeps_the_mesh[free_fall]") == \
+    assert isolation._test_words("test_vertices.py::test_sync_keeps_the_mesh[free_fall]") == \
         "test_sync_keeps_the_mesh and free_fall"
-    assert crashes._test_words("test_scenes.py::test_draws_its_collision_geometry[first-chain]") == \
+    assert isolation._test_words("test_scenes.py::test_draws_its_collision_geometry[first-chain]") == \
         "test_draws_its_collision_geometry and first and chain"

@@ -1,7 +1,7 @@
 """The kit's proof that it discriminates: it fails every deliberately wrong sync and passes every right one.
 
 Each implementation is checked end to end, the way a user runs the kit and the way the README's
-kill-rate table is made (``python -m conformance kill-rate``, :mod:`conformance.verdicts`)::
+kill-rate table is made (``python -m conformance kill-rate``, :mod:`conformance.discrimination.verdicts`)::
 
     python -m pytest --pyargs conformance -m sync -q --sync wrong_syncs:<Name> --hypothesis-profile triage -x
 
@@ -26,7 +26,8 @@ import background
 import order_syncs
 import right_syncs
 import wrong_syncs
-from conformance import scenes, verdicts
+from conformance import scenes
+from conformance.discrimination import verdicts
 
 TESTS = Path(__file__).resolve().parent
 #: The order-dependent mistakes pass every check but the sync-order machine's (``tests/test_order_checks.py``).

@@ -3,8 +3,8 @@
 
 from __future__ import annotations
 
-from conformance import kill_matrix
-from conformance.verdicts import Outcome
+from conformance.discrimination import kill_matrix
+from conformance.discrimination.verdicts import Outcome
 
 
 def _record(check, outcome="passed", scene="chain", message="", kinds=None, module="test_vertices.py"):
@@ -41,7 +41,8 @@ def test_idle_checks_and_single_points_are_listed():
 
 
 def test_the_command_writes_the_matrix_with_the_command_that_made_it(tmp_path, monkeypatch):
-    from conformance import cli, verdicts
+    from conformance import cli
+    from conformance.discrimination import verdicts
 
     monkeypatch.setattr(verdicts, "implementations", lambda module: [f"{module}:A"])
     monkeypatch.setattr(verdicts, "what_it_is", lambda spec: spec)

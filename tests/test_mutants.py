@@ -1,4 +1,4 @@
-"""Machine-made mutants (issue 17, point 2; :mod:`conformance.mutants`): the mutants are made and named
+"""Machine-made mutants (issue 17, point 2; :mod:`conformance.discrimination.mutants`): the mutants are made and named
 the same way every time, each run is classified right (not viable, killed, raised, crashed, timed out,
 survived), and the fast sample of the full run's mutants stays 100 % killed on the backend in force.
 
@@ -11,8 +11,9 @@ from __future__ import annotations
 
 import pytest
 
-from conformance import backends, mutants
-from conformance.verdicts import Outcome
+from conformance import backends
+from conformance.discrimination import mutants
+from conformance.discrimination.verdicts import Outcome
 
 #: A run of one cheap check on one scene, for the hand-made mutants (a whole run costs a minute).
 ONE_CHECK = ["-k", "test_vertices_match_poses_every_frame and chain"]
@@ -107,7 +108,7 @@ def test_the_fast_sample_is_killed(ident):
     a change to a check that lets one through fails here, per commit, before the hour-long full run."""
     found = {m.id: (name, m) for name in mutants.target_names() for m in mutants.generate(mutants.TARGETS[name]())}
     assert ident in found, (f"sample mutant {ident} is no longer made (its code changed): pick another from the full "
-                            "run's page and update conformance.mutants.SAMPLE")
+                            "run's page and update conformance.discrimination.mutants.SAMPLE")
     name, mutant = found[ident]
     result = mutants.judge(mutants.TARGETS[name](), mutant)
     assert result.state == "killed", f"{mutant.function} line {mutant.line}:\n{mutant.diff}{result}"

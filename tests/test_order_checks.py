@@ -13,7 +13,8 @@ import re
 import pytest
 from hypothesis import settings
 
-from conformance import sync, verdicts
+from conformance import sync
+from conformance.discrimination import verdicts
 from conformance import test_sync_order as order
 from conformance.checks.pytest_helpers import Kit
 from conformance.judge.tolerances import DEFAULT

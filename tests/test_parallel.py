@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 import background
-from conformance import verdicts
+from conformance.discrimination import verdicts
 
 TESTS = Path(__file__).resolve().parent
 #: Fails on pendulum (two multibodies), passes on the rest.

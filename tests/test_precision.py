@@ -11,7 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from conformance import figures, precision
+from conformance import figures
+from conformance.discrimination import precision
 from conformance.checks import profiles
 
 TESTS = Path(__file__).resolve().parent
@@ -121,7 +122,7 @@ def test_checks_gives_only_the_checks_it_picks_their_runs(tmp_path):
 def test_a_journal_keeps_each_draw_and_a_run_goes_on_where_it_stopped(tmp_path, monkeypatch):
     """Each draw is appended as it finishes; a line cut short by a kill is made again, every other draw is
     not (``precision --journal``)."""
-    from conformance import verdicts
+    from conformance.discrimination import verdicts
 
     path = tmp_path / "draws.jsonl"
     journal = precision.Journal(path)

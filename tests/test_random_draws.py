@@ -3,7 +3,7 @@
 The ``ci`` profile is derandomized, so every CI run and every kill-rate table tries the same draws;
 a user's CI runs the default profile, whose draws are random, and a false alarm there turns a right
 program red. So this file runs right programs through the checks that draw (``-m draws``) on draws
-seeded by the commit (:func:`conformance.precision.draw_seed`, printed in the session's header;
+seeded by the commit (:func:`conformance.discrimination.precision.draw_seed`, printed in the session's header;
 ``KIT_DRAW_SEED=N`` replays a slice): ``reference``, one of ``tests/right_syncs`` (which one turns with
 the seed), and one right example app with perturbed runs drawn from the seed. Over commits every right
 sync and app meets new draws; ``python -m conformance precision`` measures the rate at scale
@@ -16,7 +16,8 @@ import os
 from pathlib import Path
 
 import background
-from conformance import backends, precision, verdicts
+from conformance import backends
+from conformance.discrimination import precision, verdicts
 
 ROOT = Path(__file__).resolve().parent.parent
 SEED, SOURCE = precision.draw_seed(ROOT)

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from conformance import cli, verdicts
+from conformance import cli
+from conformance.discrimination import verdicts
 from conformance.checks import survey
 from conformance.commands.common import replace_block
 from conformance.errors import ConformanceError

@@ -1,4 +1,4 @@
-"""Which checks a run executes (:mod:`conformance.selection`): shards partition the checks, a ``-k``
+"""Which checks a run executes (:mod:`conformance.session.selection`): shards partition the checks, a ``-k``
 word that matches nothing stops the run, and a run asked to check a sync that ran no check of it
 is not green. Each run here is pytest on the kit, collect-only where that is enough."""
 
@@ -12,7 +12,7 @@ import sys
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from conformance import selection
+from conformance.session import selection
 
 
 def _pytest(*args: str, env_sync: str | None = None) -> subprocess.CompletedProcess:

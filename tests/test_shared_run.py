@@ -7,7 +7,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from conformance import verdicts
+from conformance.discrimination import verdicts
 
 TESTS = Path(__file__).resolve().parent
 SHARING = ("test_vertices_match_poses_every_frame", "test_sync_keeps_the_mesh", "test_sync_does_not_touch_physics",

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import pytest
 
-from conformance import tolerance_use
-from conformance.verdicts import Outcome
+from conformance.discrimination import tolerance_use
+from conformance.discrimination.verdicts import Outcome
 
 
 def _record(check="test_a", scene="chain", error=1e-7, tolerance=1e-6, normals=None):
@@ -46,7 +46,8 @@ def test_the_worst_use_over_syncs_and_scenes_is_kept_and_the_loose_ones_are_flag
 
 
 def test_the_command_refuses_figures_from_a_sync_that_fails(monkeypatch, capsys):
-    from conformance import cli, verdicts
+    from conformance import cli
+    from conformance.discrimination import verdicts
 
     monkeypatch.setattr(verdicts, "check_all", lambda specs, **kwargs: [Outcome(s, 1, [_record()]) for s in specs])
     assert cli.main(["tolerance-use", "wrong_syncs:DoesNothing"]) == 1
@@ -54,7 +55,8 @@ def test_the_command_refuses_figures_from_a_sync_that_fails(monkeypatch, capsys)
 
 
 def test_the_command_writes_the_table_with_the_command_that_made_it(tmp_path, monkeypatch):
-    from conformance import cli, verdicts
+    from conformance import cli
+    from conformance.discrimination import verdicts
 
     monkeypatch.setattr(verdicts, "check_all", lambda specs, **kwargs: [
         Outcome(s, 0, [_record()], images=[_image(metrics={"sync: flip_mean": 0.01}, limits={"sync: flip_mean": 0.02})])

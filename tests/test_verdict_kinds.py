@@ -18,7 +18,8 @@ from pathlib import Path
 import pytest
 
 import wrong_syncs
-from conformance import backends, sync, verdicts
+from conformance import backends, sync
+from conformance.discrimination import verdicts
 from conformance.checks import survey
 from conformance import test_vertices as checks
 from conformance.checks.pytest_helpers import Kit

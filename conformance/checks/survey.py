@@ -49,7 +49,7 @@ __all__ = [
 
 #: The worst vertex error a check measured (failing or not), for the verdict table's ✓ cells.
 WORST = pytest.StashKey[dict]()
-#: The worst vertex-normal angle a check saw, in its tolerance (:mod:`conformance.tolerance_use`).
+#: The worst vertex-normal angle a check saw, in its tolerance (:mod:`conformance.discrimination.tolerance_use`).
 WORST_NORMALS = pytest.StashKey[dict]()
 #: The survey of a check running in survey mode.
 SURVEY = pytest.StashKey["Survey"]()

@@ -99,7 +99,8 @@ def image_frame_for(image: int | str | None, frames: int, scene: str) -> int | N
 def run(args, extra) -> int:
     import contextlib
 
-    from conformance import scenes, side_by_side, sync
+    from conformance import scenes, sync
+    from conformance.discrimination import side_by_side
     from conformance.progress import progress
 
     frames = frames_option(args.frames)

@@ -1,6 +1,6 @@
 """``kill-rate --wrong MODULE --right MODULE [--matrix OUT.md]``: how many deliberately wrong syncs the
 checks reject; with ``--matrix``, every wrong sync through every check (survey runs) and the matrix of
-which check kills which (:mod:`conformance.kill_matrix`)."""
+which check kills which (:mod:`conformance.discrimination.kill_matrix`)."""
 
 from __future__ import annotations
 
@@ -27,7 +27,8 @@ def add_arguments(parser) -> None:
 
 
 def run(args, extra) -> int:
-    from conformance import backends, verdicts
+    from conformance import backends
+    from conformance.discrimination import verdicts
 
     wrong = [spec for module in args.wrong for spec in verdicts.implementations(module)]
     right = verdicts.implementations(args.right)
@@ -40,7 +41,7 @@ def run(args, extra) -> int:
     text = verdicts.kill_rate_table(outcomes, accepted, summaries)
     emit(f"Checked on the {backends.describe()}.\n\n{text}", args.out)  # which FURY, in every copy
     if args.matrix:
-        from conformance import kill_matrix
+        from conformance.discrimination import kill_matrix
         from conformance.files import write_atomically
 
         import shlex

@@ -1,6 +1,6 @@
 """``mutants [--target NAME…] [--sample] [--results FILE.json] [--out PAGE.md]``: mutants of the kit's own
 right syncs, each judged by the kit, and the page with the score and every survivor's verdict
-(:mod:`conformance.mutants`)."""
+(:mod:`conformance.discrimination.mutants`)."""
 
 from __future__ import annotations
 
@@ -16,13 +16,13 @@ TAKES_PYTEST_ARGS = True
 
 
 def add_arguments(parser) -> None:
-    from conformance import mutants
+    from conformance.discrimination import mutants
 
     parser.add_argument("--target", action="append", choices=mutants.target_names(), default=None,
                         help="what to mutate (repeatable; default all): frames (frames.py, both references share it), "
                         "reference (the backend's own reference.py), vectorised (tests/: right_syncs' einsum closure)")
     parser.add_argument("--sample", action="store_true", help="only the fixed fast sample that CI keeps at 100 %% "
-                        "(conformance.mutants.SAMPLE)")
+                        "(conformance.discrimination.mutants.SAMPLE)")
     parser.add_argument("--results", type=argparse_type(file_to_write, "--results"), default=None, metavar="FILE.json",
                         help="keep every mutant's result here, and judge only the mutants it does not have yet "
                         "(a mutant's id changes with its code, so a changed file is judged anew)")
@@ -32,7 +32,8 @@ def add_arguments(parser) -> None:
 
 
 def run(args, extra) -> int:
-    from conformance import backends, mutants
+    from conformance import backends
+    from conformance.discrimination import mutants
     from conformance.errors import ConformanceError
     from conformance.files import write_atomically
 
@@ -45,7 +46,7 @@ def run(args, extra) -> int:
         missing = set(sample) - {m.id for ms in found.values() for m in ms} if not args.target else set()
         if missing:
             raise ConformanceError(f"the fast sample names mutants that are no longer made: {', '.join(sorted(missing))} (the "
-                                   "mutated code changed); pick others from the full run's page and update conformance.mutants.SAMPLE")
+                                   "mutated code changed); pick others from the full run's page and update conformance.discrimination.mutants.SAMPLE")
     results = mutants.load_results(args.results) if args.results else {}
     meta = {"backend": backends.NAME, "fury": backends.fury_version()}
     started = time.monotonic()

@@ -1,6 +1,6 @@
 """``precision [SPEC…] [--right MODULE] [--apps GLOB…] --seeds N``: how often the kit rejects right syncs
 and right apps over random draws, with each check's worst use of its allowances
-(:mod:`conformance.precision`). Exits 1 on any false alarm."""
+(:mod:`conformance.discrimination.precision`). Exits 1 on any false alarm."""
 
 from __future__ import annotations
 
@@ -50,7 +50,8 @@ def run(args, extra) -> int:
     import shlex
     import sys
 
-    from conformance import backends, precision, sync, verdicts
+    from conformance import backends, sync
+    from conformance.discrimination import precision, verdicts
 
     named = list(args.specs) or ([] if args.apps or args.right else ["reference"])
     others = [spec for module in args.right for spec in verdicts.implementations(module) if spec not in named]

@@ -1,5 +1,5 @@
 """``tolerance-use [SPEC…] [--right MODULE] [--out FILE]``: how much of each tolerance right syncs use,
-and which tolerances are loose (:mod:`conformance.tolerance_use`)."""
+and which tolerances are loose (:mod:`conformance.discrimination.tolerance_use`)."""
 
 from __future__ import annotations
 
@@ -23,7 +23,8 @@ def add_arguments(parser) -> None:
 def run(args, extra) -> int:
     import shlex
 
-    from conformance import backends, sync, tolerance_use, verdicts
+    from conformance import backends, sync
+    from conformance.discrimination import tolerance_use, verdicts
 
     specs = list(args.specs) + [spec for module in args.right for spec in verdicts.implementations(module)]
     specs = specs or ["reference"]
@@ -49,5 +50,5 @@ def run(args, extra) -> int:
     missing = tolerance_use.unexplained(worst)
     if missing:
         print(f"note: {', '.join(missing)} used under {tolerance_use.LOOSE:.0%} of the allowance and no reason is "
-              "written for keeping it (conformance/tolerance_use.py, REASONS): tighten it or say why it stays.")
+              "written for keeping it (conformance/discrimination/tolerance_use.py, REASONS): tighten it or say why it stays.")
     return 0

@@ -28,7 +28,8 @@ def add_arguments(parser) -> None:
 
 
 def run(args, extra) -> int:
-    from conformance import backends, sync, verdicts
+    from conformance import backends, sync
+    from conformance.discrimination import verdicts
 
     for spec in args.specs:  # a spec that cannot load fails now, in one paragraph, not minutes later in a table
         sync.load(spec)

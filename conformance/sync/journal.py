@@ -1,4 +1,4 @@
-"""The worker's half of crash isolation (:mod:`conformance.crashes` is the controller's): where this
+"""The worker's half of crash isolation (:mod:`conformance.session.isolation` is the controller's): where this
 process is in the sync under test, noted before every call into it, so that the process that outlives a
 crash can say where it happened; and the crashes already seen, so a crashed scene is not run again.
 

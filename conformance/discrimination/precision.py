@@ -1,6 +1,6 @@
 """Precision: how often the kit rejects a right sync or a right app, measured over many random draws.
 
-The kill rate (:mod:`conformance.verdicts`) shows every wrong sync rejected on the derandomized draws
+The kill rate (:mod:`conformance.discrimination.verdicts`) shows every wrong sync rejected on the derandomized draws
 every CI run makes; a user's CI runs the default profile, whose draws are random, and one false alarm
 there turns a right program red (and the example database replays it on every later run). This runs
 right syncs through the checks that draw at random (``-m draws``) under the ``precision`` profile: no
@@ -167,7 +167,7 @@ def _run_all(todo, make, journal, jobs, what):
 
 
 def pytest_args(seed: int, select: str = "") -> list[str]:
-    """What each process adds to :func:`conformance.verdicts.command`: the drawing checks (those ``-k select``
+    """What each process adds to :func:`conformance.discrimination.verdicts.command`: the drawing checks (those ``-k select``
     picks, if given), the precision profile, the seed."""
     return ["-m", "draws", *(["-k", select] if select else []), "--hypothesis-profile", "precision",
             f"--hypothesis-seed={seed}"]
@@ -190,7 +190,7 @@ def sync_draws(specs, seeds, *, factor: int, select: str = "", jobs: int | None 
     once per seed, ``jobs`` processes at a time (those the ``journal`` holds already are not made again)."""
     import os
 
-    from conformance import verdicts
+    from conformance.discrimination import verdicts
     from conformance.checks.profiles import DRAW_FACTOR
 
     env = {**os.environ, DRAW_FACTOR: str(factor)}

@@ -6,7 +6,7 @@ for every check, whether it rejects each wrong sync on its own, so that two thin
 kills no mistake on its own (it is kept for a reason the docs give, or it is strengthened), and a
 mistake that only one check kills (a single point of failure: weaken that check and the mistake
 passes). A cell is one of Stryker's mutant states, as they apply to a check: killed, survived,
-crashed (the process died in the sync: :mod:`conformance.crashes`), timed out (a sync call over its
+crashed (the process died in the sync: :mod:`conformance.session.isolation`), timed out (a sync call over its
 limit: :mod:`conformance.sync.time_limit`), or not run (no record of the check: deselected).
 """
 

@@ -3,14 +3,14 @@ point 2; docs/mutants-vtk.md, docs/discrimination.md#machine-made-mutants).
 
 Every mutant is one small change that mutmut's operators make to a right sync (a number, an operator,
 a name, an argument dropped, an assignment turned to ``None``, …), written as an importable module in a
-temporary directory of its own and checked like any sync: :func:`conformance.verdicts.check` runs the
+temporary directory of its own and checked like any sync: :func:`conformance.discrimination.verdicts.check` runs the
 sync checks on it in a pytest process of its own, Hypothesis profile ``triage``, stopping at the first
 failure. What a mutant is, from that run (:func:`classify`):
 
 * **killed**: a check failed on it (``raised`` when the failure is the mutant raising in a step: the kit
   rejects it, but no property had to);
 * **crashed** / **timed out**: it killed its worker process, or a call did not return within the limit;
-  the kit rejects those too (:mod:`conformance.crashes`, :mod:`conformance.sync.time_limit`);
+  the kit rejects those too (:mod:`conformance.session.isolation`, :mod:`conformance.sync.time_limit`);
 * **not viable**: it cannot be imported, or raises while being set up: it is not a sync at all;
 * **survived**: every check passed. A survivor is either *equivalent* (it draws the same thing: the
   argument is kept in :data:`VERDICTS_FILE`, by the mutant's :attr:`Mutant.id`) or a gap in the checks;
@@ -39,7 +39,7 @@ from conformance.errors import ConformanceError
 __all__ = ["Mutant", "Result", "SAMPLE", "STATES", "Target", "TARGETS", "VERDICTS_FILE", "classify", "generate", "judge",
            "load_results", "markdown", "read_verdicts", "save_results", "score", "target_names"]
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]  # the checkout: conformance/discrimination/mutants.py
 #: The hand-kept verdicts on survivors: one line each, ``<id> <verdict>: <argument>``.
 VERDICTS_FILE = ROOT / "docs" / "mutant-verdicts.txt"
 #: Every state a mutant can end in, in the order the tables list them.
@@ -87,7 +87,7 @@ def _frames_modules(mutated: str) -> dict[str, str]:
     rewired = reference.replace("from conformance.implementations.frames import", "from mutant_frames import")
     if rewired == reference:
         raise ConformanceError(f"{_reference_path()} no longer imports conformance.implementations.frames by name; "
-                               "conformance/mutants.py must rewire the mutated frames.py into it some other way")
+                               "conformance/discrimination/mutants.py must rewire the mutated frames.py into it some other way")
     return {"mutant_frames": mutated, SYNC_MODULE: rewired}
 
 
@@ -197,7 +197,7 @@ class Result:
 
 
 def classify(outcome) -> tuple[str, dict]:
-    """The state of a mutant from its run (a :class:`conformance.verdicts.Outcome` of a stop-at-first run),
+    """The state of a mutant from its run (a :class:`conformance.discrimination.verdicts.Outcome` of a stop-at-first run),
     and the record that decided it (``{}`` when none did)."""
     failed = outcome.failed
     if not outcome.records and "did not complete within" in outcome.stderr:
@@ -224,7 +224,7 @@ def judge(target: Target, mutant: Mutant | None, *, pytest_args: Sequence[str] =
     """Check one mutant (``None``: the unmutated copy) with the kit, in a pytest process of its own, stopped
     after ``timeout`` seconds (a mutant can loop in the kit's own code, where no per-call limit reaches:
     one ran over 20 minutes in the first full run)."""
-    from conformance import verdicts
+    from conformance.discrimination import verdicts
 
     source = mutant.source if mutant else (ROOT / target.path).read_text(encoding="utf-8")
     with tempfile.TemporaryDirectory(prefix="conformance-mutant-") as tmp:

@@ -1,7 +1,7 @@
 """How much of each tolerance right syncs use: the figure behind "nothing too loose" (issue 17).
 
 A tolerance is there to let a right sync pass; one that a right sync never comes near lets wrong ones
-pass too. From the runs of right syncs (:func:`conformance.verdicts.check`), this collects, per
+pass too. From the runs of right syncs (:func:`conformance.discrimination.verdicts.check`), this collects, per
 *allowance* (a vertex check's position tolerance, its normals' angle, each golden-picture metric of the
 sync verdict and of the renderer verdict, the silhouettes' pixels off), the largest fraction of it that any right sync
 used on any scene and frame, and where. An allowance whose worst use is under :data:`LOOSE` (a tenth)
