@@ -121,10 +121,10 @@ class SharedActor:
             np.asarray(normals[t.start:t.stop], dtype=np.float64) @ u.as_matrix()  # row vectors: × R = R⁻¹ applied
             for u, t in zip(undo, targets)
         ])
-        # Where the vertices go: one block of the array when the ranges tile it in order, else an index.
-        tiled = all(a.stop == b.start for a, b in zip(targets, targets[1:]))
-        self.block = slice(targets[0].start, targets[-1].stop) if tiled else None
-        self.index = None if tiled else np.concatenate([np.arange(t.start, t.stop) for t in targets])
+        # Where the vertices go: one block of the array, since the backends lay out a shared actor's bodies
+        # one after another in the targets' order (backends/common.py), and every one of them is here
+        # (a shared target is never posed directly).
+        self.block = slice(targets[0].start, targets[-1].stop)
 
     def __call__(self, positions: np.ndarray, matrices: np.ndarray) -> None:
         rotations = matrices[self.rows]
@@ -135,7 +135,7 @@ class SharedActor:
 
     def _write(self, array: np.ndarray, rotations: np.ndarray, local: np.ndarray, positions) -> None:
         """``array`` rows of the targets = rotations × local (+ positions), each vertex as a row."""
-        if self.block is not None and array.dtype == np.float64:
+        if array.dtype == np.float64:
             # Straight into the actor's own array: no temporary the size of the vertices.
             out = array[self.block].reshape(local.shape)
             np.matmul(local, rotations.transpose(0, 2, 1), out=out)
@@ -145,10 +145,7 @@ class SharedActor:
         moved = np.matmul(local, rotations.transpose(0, 2, 1))
         if positions is not None:
             moved += positions[:, None, :]
-        if self.block is not None:
-            array[self.block] = moved.reshape(-1, 3)  # one rounding to the array's type (float32)
-        else:
-            array[self.index] = moved.reshape(-1, 3)
+        array[self.block] = moved.reshape(-1, 3)  # one rounding to the array's type (float32)
 
 
 def split(client: int, targets: tuple[Target, ...], direct_allowed: bool) -> tuple[list, list, dict]:
