@@ -88,3 +88,24 @@ def test_a_cloth_copied_but_for_its_last_nodes_leaves_them_undrawn(tmp_path):
     verdict = apps.check_app(_copy(tmp_path, short), ticks=60).verdicts
     failed = {k for k, v in verdict.items() if not v.passed}
     assert "drawn" in failed or "attached" in failed, failed
+
+
+def test_the_right_cloth_is_pictured_where_pybullet_draws_it():
+    """``pictured`` judges a soft body as one surface: the right cloth's pixels are pyBullet's, to a few edge
+    pixels, at every picture."""
+    verdict = apps.check_app(CLOTH, ticks=60).verdicts["pictured"]
+    assert verdict.passed, verdict.message()
+    cloth = [t for record, _ in verdict.pictures for t in record.details["targets"] if t["target"].startswith("soft body")]
+    assert len(cloth) == len([p for p in verdict.pictures]) and all(t["iou"] >= 0.98 for t in cloth), cloth
+
+
+def test_a_cloth_whose_triangles_join_other_nodes_is_not_pictured(tmp_path):
+    """Every vertex on its node, every node followed, the triangles made for the nodes sorted by np.unique:
+    no vertex check can see it; the picture does (``face-order``)."""
+    old = "nodes = np.array(nodes)\n" if backends.NAME == "vtk" else "nodes = np.array(nodes, dtype=np.float32)\n"
+    sorted_nodes = SOURCE.replace(old, f"nodes = np.unique({old.split(' = ')[1].strip()}, axis=0)\n")
+    assert sorted_nodes != SOURCE
+    verdicts = apps.check_app(_copy(tmp_path, sorted_nodes), ticks=30).verdicts
+    assert {k for k, v in verdicts.items() if not v.passed} == {"pictured"}, {k: v.message() for k, v in verdicts.items()}
+    assert verdicts["pictured"].diagnoses == ["face-order"], verdicts["pictured"].message()
+    assert "soft body 0 (cloth_z_up) is not where pyBullet's renderer draws it" in verdicts["pictured"].message()

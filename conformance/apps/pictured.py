@@ -26,7 +26,11 @@ Which frames are judged, and what the others are:
 * a frame that shows only an edge in both pictures (:func:`edges_only`) is left out;
 * where a sphere or cylinder hides another body, the pixels its two outlines (tessellated differently
   by the two renderers) disagree on within :data:`ROUNDED_SLACK` pixels are left out
-  (:func:`rounded_outlines`), as the silhouette check leaves out the edge of each body.
+  (:func:`rounded_outlines`), as the silhouette check leaves out the edge of each body;
+* a soft body some drawn vertex follows is judged as one body, every pixel of a face whose first vertex
+  follows one of its nodes against every pixel pyBullet's renderer draws of it, by a box's threshold
+  (:func:`soft_labels`): its vertices may all follow their nodes while its triangles join other nodes
+  (diagnosis ``face-order``).
 """
 
 from __future__ import annotations
@@ -78,10 +82,29 @@ def _statuses(judgement) -> tuple[set[int], set[int], set[int]]:
     return ((judged - refused - elsewise - background) & kinds) | unlike, background, unlike
 
 
+def soft_labels(judgement) -> dict[int, int]:
+    """Each node frame of a soft body that some drawn vertex follows → the body's first node frame, which
+    stands for the whole body in the pictures (pyBullet's renderer draws a soft body as one surface)."""
+    r = judgement.r
+    first: dict[tuple, int] = {}
+    for i, f in enumerate(r.frames):
+        if f.node >= 0:
+            first.setdefault((f.client, f.body), i)
+    if not first or not judgement.attachments:
+        return {}
+    held = np.unique(np.concatenate([a.frame[a.held] for a in judgement.attachments]))
+    drawn = {first[(r.frames[i].client, r.frames[i].body)] for i in held.tolist() if i >= 0 and r.frames[i].node >= 0}
+    return {i: first[(f.client, f.body)] for i, f in enumerate(r.frames)
+            if f.node >= 0 and first[(f.client, f.body)] in drawn}
+
+
 def limits_of(frame) -> tuple[float, tuple[float, float] | None]:
     """The silhouette threshold and sphere rounding of what pyBullet's renderer draws of ``frame``: its visual
     shapes where it has any (a mesh is drawn from the same triangles by both: a box's threshold), else its
-    one collision shape."""
+    one collision shape; a soft body's node stands for its surface, drawn from the same triangles by both
+    when the app is right: a box's threshold."""
+    if frame.node >= 0:
+        return silhouettes.MIN_IOU["box"], None
     kinds = [v[0] for v in frame.visuals] or ([frame.shapes[0][0]] if len(frame.shapes) == 1 else [])
     if not kinds:
         return 1.0, None
@@ -90,10 +113,11 @@ def limits_of(frame) -> tuple[float, tuple[float, float] | None]:
 
 
 def labels(shot: dict, recording, attachments, judged: set[int], background: set[int],
-           decorations: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+           decorations: np.ndarray | None = None, soft: dict[int, int] | None = None) -> tuple[np.ndarray, np.ndarray]:
     """``(fury, bullet)``: each pixel's judged frame index in the two pictures of ``shot``, -1 for none
     or background, and -1 in both where either shows an unknown frame or a ``decorations`` vertex (a
-    mask over every actor's vertices, in order; left out)."""
+    mask over every actor's vertices, in order; left out); a soft body's node frames all carry the label
+    ``soft`` gives them (:func:`soft_labels`)."""
     # A vertex no frame holds (``attached`` fails it) is unknown: its best guess may be the world, and as
     # background it would count against every body it hides. So is a decoration pyBullet does not have
     # (FURY's own demos add actor.axes() at the origin, in front of two bricks of the brick wall).
@@ -110,6 +134,8 @@ def labels(shot: dict, recording, attachments, judged: set[int], background: set
         table[f] = -1
     for f in judged:
         table[f] = f
+    for f, label in (soft or {}).items():
+        table[f] = label
     vertices = np.asarray(shot["vertices"], dtype=np.int64)
     seen = vertices >= 0
     fury = np.where(vertices == UNKNOWN, UNKNOWN, -1).astype(np.int64)
@@ -127,13 +153,14 @@ def labels(shot: dict, recording, attachments, judged: set[int], background: set
 def _decorations(judgement, unlike: set[int]) -> np.ndarray:
     """Over every actor's vertices in order: those drawn as something pyBullet does not have, whose pixels
     are left out — held by the world, or by a frame whose shape ``placed`` refused them as, unless nothing
-    draws that frame's shape (``unlike``: then the drawing is the body's, and is judged)."""
+    draws that frame's shape (``unlike``: then the drawing is the body's, and is judged). A soft body's
+    node has no shape to refuse a drawing as: what follows it is the body's drawing."""
     if not judgement.attachments:
         return np.zeros(0, bool)
     starts = dict(zip(map(id, judgement.attachments), np.cumsum([0] + [a.frame.shape[0] for a in judgement.attachments])))
     mask = np.concatenate([a.held & (a.frame < 0) for a in judgement.attachments])
     for _track, a, frame, rows, result in judgement.placements():
-        if not result.judged and frame not in unlike:
+        if not result.judged and frame not in unlike and judgement.r.frames[frame].node < 0:
             mask[starts[id(a)] + rows] = True
     return mask
 
@@ -220,14 +247,14 @@ def _rounds(shot: dict, recording, rounding) -> tuple[list, list]:
     return discs, radii
 
 
-def _diagnosis(frame: int, shot: dict, recording, attachments) -> str:
-    """``hidden`` when the actors drawing ``frame`` are hidden or mostly too faint; ``stale-gpu`` when the
-    GPU holds some of its vertices elsewhere than their arrays; else none."""
+def _diagnosis(frames: list[int], shot: dict, recording, attachments) -> str:
+    """``hidden`` when the actors drawing ``frames`` (one body's) are hidden or mostly too faint; ``stale-gpu``
+    when the GPU holds some of their vertices elsewhere than their arrays; else none."""
     hidden = shot.get("hidden", [])
     faint, stale = np.asarray(shot["faint"], bool), np.asarray(shot["stale"], bool)
     start, held, invisible = 0, [], False
     for k, (track, a) in enumerate(zip(recording.actors, attachments)):
-        rows = np.flatnonzero(a.frame == frame) + start
+        rows = np.flatnonzero(np.isin(a.frame, frames)) + start
         start += track.vertices.shape[1]
         if len(rows):
             held.append(rows)
@@ -248,7 +275,14 @@ def check(judgement):
     r = judgement.r
     verdict = Verdict("pictured", True)
     judged, background, unlike = _statuses(judgement)
+    soft = soft_labels(judgement)
+    members: dict[int, list[int]] = {}
+    for f, label in soft.items():
+        members.setdefault(label, []).append(f)
     names = [f.label for f in r.frames]
+    for label in members:
+        f = r.frames[label]
+        names[label] = f"{f'client {f.client} ' if f.client else ''}soft body {f.body}" + (f" ({f.name})" if f.name else "")
     limits, rounding = zip(*[limits_of(f) for f in r.frames]) if r.frames else ((), ())
     limits, rounding = list(limits), list(rounding)
     app = Path(r.script).name
@@ -260,7 +294,7 @@ def check(judgement):
         if "skipped" in shot:
             verdict.notes.append(f"no picture at tick {shot['tick']}: {shot['skipped']}")
             continue
-        fury, bullet = labels(shot, r, judgement.attachments, judged, background, decorations)
+        fury, bullet = labels(shot, r, judgement.attachments, judged, background, decorations, soft)
         outline = rounded_outlines(fury, bullet, rounded, ROUNDED_SLACK)
         fury[outline], bullet[outline] = -1, -1
         rims = edges_only(fury, bullet)
@@ -289,7 +323,11 @@ def check(judgement):
         failing = [t for t in targets if not t["passed"]]
 
         def why_off(t, shot=shot):
-            return _diagnosis(t["index"], shot, r, judgement.attachments) or ("not-its-shape" if t["index"] in unlike else "")
+            own = members.get(t["index"], [t["index"]])
+            # A soft body whose vertices all follow their nodes (attached) yet whose picture is not pyBullet's:
+            # its triangles join other nodes.
+            return (_diagnosis(own, shot, r, judgement.attachments) or ("not-its-shape" if t["index"] in unlike else "")
+                    or ("face-order" if t["index"] in members else ""))
         verdict.pictures.append((record, silhouettes.mask_images(fury, bullet) if failing else {}))
         explained: dict[str, int] = {}
         first = len(verdict.lines)

@@ -46,6 +46,10 @@ DIAGNOSES = {name: text for name, (text, _) in attach_mod.VARIANTS.items()} | {
                   "than the nodes are copied into them (a mesh file read by another library reorders or merges "
                   "vertices): build the actor from getMeshData(body, -1, flags=p.MESH_DATA_SIMULATION_MESH) and copy "
                   "the nodes in that same order",
+    "face-order": "every vertex follows a node of this soft body, but its triangles are not pyBullet's: the faces were "
+                  "built for another order of the vertices than the one the nodes are copied in (np.unique sorts what it "
+                  "returns; mesh libraries merge or reorder vertices): build the faces for the node order of "
+                  "getMeshData(body, -1, flags=p.MESH_DATA_SIMULATION_MESH) and copy the nodes in that same order",
     "stale-gpu": "the GPU still holds older vertices of this body: the vertices were written but the range announced "
                  "with positions.update_range(offset, count) does not cover them (offset and count are in vertices); "
                  "announce every range written, or update_full()",
