@@ -400,6 +400,9 @@ class _Judgement:
     def normals(self) -> Verdict:
         verdict = Verdict("normals", True)
         worst = 0.0
+        # A soft body's node has a position and no turn: the normals of a surface that follows nodes turn
+        # with its shape, which a right program recomputes every tick; they are not a frame's to judge.
+        soft = np.array([f.node >= 0 for f in self.r.frames] + [False])  # the last entry: the world (-1)
         for track, a in zip(self.r.actors, self.attachments):
             if track.normals is None:
                 continue
@@ -414,8 +417,13 @@ class _Judgement:
             reference /= np.maximum(np.linalg.norm(reference, axis=1, keepdims=True), 1e-12)
             angle = np.arccos(np.clip(np.einsum("tni,ni->tn", local, reference), -1, 1))
             # Vertices no frame holds fail `attached`; their normals have no frame to turn with.
-            worst = max(worst, float(angle[:, a.held].max(initial=0)) / self.tolerance.normal_angle)
-            bad = np.any(angle > self.tolerance.normal_angle, axis=0) & a.held
+            on_nodes = soft[frames] & a.held
+            judged = a.held & ~on_nodes
+            if on_nodes.any():
+                verdict.notes.append(f"{track.label}: {int(on_nodes.sum())} vertices follow soft-body nodes, whose normals "
+                                     "turn with the surface's shape, not with a frame: not judged")
+            worst = max(worst, float(angle[:, judged].max(initial=0)) / self.tolerance.normal_angle)
+            bad = np.any(angle > self.tolerance.normal_angle, axis=0) & judged
             for start, stop in _runs(bad, frames):
                 verdict.passed = False
                 first = int(np.flatnonzero(np.any(angle[:, start:stop] > self.tolerance.normal_angle, axis=1))[0])
