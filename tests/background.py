@@ -6,6 +6,11 @@ other cores idle while this process runs everything else; so ``conftest.py`` ask
 test module for the runs it will need (its ``background_runs(items)``: key -> (priority, callable))
 and starts them all at once, longest first, one per core. A test then waits for its run's result.
 Under pytest-xdist the workers already share the cores: each run is started when its test asks.
+
+This process is then single-threaded in BLAS (:func:`one_blas_thread`): the runs start their processes
+from threads while the main thread computes, and a fork while the main thread is inside a multi-threaded
+OpenBLAS call deadlocks both, in OpenBLAS's own fork handler (measured: a ``./kit test`` hung for good with
+the main thread in a matmul of the app judge and a run's thread in ``blas_thread_shutdown_``).
 """
 
 from __future__ import annotations
@@ -14,15 +19,28 @@ import os
 from concurrent.futures import Future, ThreadPoolExecutor
 from typing import Callable
 
-__all__ = ["result", "start_all", "stop"]
+from threadpoolctl import threadpool_limits
+
+__all__ = ["OWN_SYNCS", "one_blas_thread", "result", "start_all", "stop"]
+
+#: The options of a run of the kit's own syncs (``tests/*_syncs.py``): in pytest's own process, as they do
+#: not crash; a pytest-xdist worker of its own cost each run 2.5 s of CPU more (``test_discrimination``).
+OWN_SYNCS = ["--conformance-isolation", "none"]
 
 _pool: ThreadPoolExecutor | None = None
 _futures: dict[str, Future] = {}
 
 
+def one_blas_thread() -> None:
+    """Every BLAS library loaded in this process computes on one thread from now on (the kit's arrays are
+    stacks of small matrices: it loses nothing), so no fork can meet a BLAS call mid-way (see above)."""
+    threadpool_limits(limits=1, user_api="blas")
+
+
 def _executor() -> ThreadPoolExecutor:
     global _pool
     if _pool is None:
+        one_blas_thread()
         _pool = ThreadPoolExecutor(max_workers=os.cpu_count() or 1, thread_name_prefix="kit-run")
     return _pool
 

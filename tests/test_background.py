@@ -1,0 +1,22 @@
+"""The process that starts the kit's background runs from threads cannot deadlock in a fork
+(``tests/background.py``): it computes BLAS on one thread before its first run starts."""
+
+from __future__ import annotations
+
+from threadpoolctl import threadpool_info, threadpool_limits
+
+import background
+
+
+def test_the_runs_pool_starts_after_blas_is_down_to_one_thread(monkeypatch):
+    monkeypatch.setattr(background, "_pool", None)
+    with threadpool_limits(limits=2, user_api="blas"):  # a machine of 2+ cores without OPENBLAS_NUM_THREADS
+        assert {p["num_threads"] for p in threadpool_info() if p["user_api"] == "blas"} == {2}
+        pool = background._executor()
+        try:
+            threads = {p["filepath"]: p["num_threads"] for p in threadpool_info() if p["user_api"] == "blas"}
+        finally:
+            pool.shutdown()
+    assert threads and set(threads.values()) == {1}, (
+        f"BLAS threads {threads} while the pool's threads fork, but should be 1 in every library: a fork "
+        "during a multi-threaded OpenBLAS call deadlocks")
