@@ -240,7 +240,8 @@ class Kit:
         """What is drawn now is right: vertices where pybullet says, normals turned with them, and
         every change announced to the renderer. Survey mode checks all three and notes what failed."""
         __tracebackhide__ = True
-        results = compare.compare_vertices(run.drawing, run.frame, self.tolerance)
+        frames = compare.link_poses(run.drawing)  # read once for vertices and normals alike
+        results = compare.compare_vertices(run.drawing, run.frame, self.tolerance, frames=frames)
         self._record(results)
         sync = self.sync
         # The same order and messages as assert_vertices_match, assert_normals_turn and
@@ -259,7 +260,7 @@ class Kit:
                          first=(lambda: first) if first is not None else (
                              lambda: _vertices_message(failures, run, sync, drawn=drawn(), tolerance=self.tolerance)),
                          value=worst.error, limit=worst.tolerance, unit="m", frame=worst.frame, target=worst.target)
-        normals = compare.compare_normals(run.drawing, run.frame, self.tolerance)
+        normals = compare.compare_normals(run.drawing, run.frame, self.tolerance, frames=frames)
         if normals:
             worst = max(normals, key=lambda r: r.angle / r.tolerance)
             figures.note("normals angle", worst.angle, worst.tolerance, where=f"{worst.target!r} frame {worst.frame}")

@@ -25,6 +25,7 @@ __all__ = [
     "compare_normals",
     "compare_vertices",
     "drawn_overlap",
+    "link_poses",
 ]
 
 
@@ -108,11 +109,20 @@ def _gather(drawing: Drawing, rows, read) -> np.ndarray:
     return np.stack(parts)
 
 
-def compare_vertices(drawing: Drawing, frame: int, tolerance: Tolerance = DEFAULT) -> list[VertexResult]:
-    """One record per target: the worst vertex of what the renderer draws vs pybullet's pose."""
+def link_poses(drawing: Drawing) -> tuple[np.ndarray, np.ndarray]:
+    """pyBullet's link-frame pose of every target now: positions ``(n, 3)`` and rotation matrices
+    ``(n, 3, 3)``. A caller comparing vertices and normals at one frame reads them once and passes them
+    to both (``frames=``): reading them is most of a frame's comparison."""
+    positions, orientations = truth.link_frames(drawing.world.p, [(t.body, t.link) for t in drawing.targets])
+    return positions, poses.matrices(orientations)
+
+
+def compare_vertices(drawing: Drawing, frame: int, tolerance: Tolerance = DEFAULT, *,
+                     frames: tuple[np.ndarray, np.ndarray] | None = None) -> list[VertexResult]:
+    """One record per target: the worst vertex of what the renderer draws vs pybullet's pose
+    (``frames``: :func:`link_poses` read at this frame, else read here)."""
     targets = drawing.targets
-    positions, orientations = truth.link_frames(drawing.world.p, [(t.body, t.link) for t in targets])
-    rotations = poses.matrices(orientations)
+    positions, rotations = frames if frames is not None else link_poses(drawing)
     layout = _layout(drawing)
     drawn = {}
 
@@ -206,13 +216,14 @@ class NormalResult:
                 f"rotated normal, but should be within {self.tolerance:.3g} rad (lighting would be wrong)")
 
 
-def compare_normals(drawing: Drawing, frame: int, tolerance: Tolerance = DEFAULT) -> list[NormalResult]:
-    """Targets whose actor stores vertex normals: they must turn with the body."""
+def compare_normals(drawing: Drawing, frame: int, tolerance: Tolerance = DEFAULT, *,
+                    frames: tuple[np.ndarray, np.ndarray] | None = None) -> list[NormalResult]:
+    """Targets whose actor stores vertex normals: they must turn with the body (``frames`` as for
+    :func:`compare_vertices`)."""
     layout = _layout(drawing)
     if not layout.normal_groups:
         return []
-    _, orientations = truth.link_frames(drawing.world.p, [(t.body, t.link) for t in drawing.targets])
-    rotations = poses.matrices(orientations)
+    _, rotations = frames if frames is not None else link_poses(drawing)
     lit = {}
 
     def read(actor):

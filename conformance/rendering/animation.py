@@ -77,8 +77,9 @@ def check_frame(run, frame: int, tolerance=None) -> FrameCheck:
     from conformance.judge import compare
 
     tolerance = tolerance or compare.DEFAULT
-    vertices = compare.compare_vertices(run.drawing, frame, tolerance)
-    normals = compare.compare_normals(run.drawing, frame, tolerance)
+    frames = compare.link_poses(run.drawing)
+    vertices = compare.compare_vertices(run.drawing, frame, tolerance, frames=frames)
+    normals = compare.compare_normals(run.drawing, frame, tolerance, frames=frames)
     ranked = [(_ratio(r.error, r.tolerance), r.describe()) for r in vertices if not r.ok]
     ranked += [(_ratio(r.angle, r.tolerance), r.describe()) for r in normals if not r.ok]
     unannounced = [f"actor {name!r}: {missed}" for f, name, missed in run.unannounced if f == frame]
