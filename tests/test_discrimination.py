@@ -10,7 +10,10 @@ failed; not 2, 3 or 4, which are errors) with a failure that names the scene and
 (``[scene(params), frame N, …]``); a right one must make the same command without ``-x`` exit 0.
 The ``triage`` profile is derandomized, so every run of this file tries the same examples.
 
-The runs start with the session, one per core at a time (``background``).
+The runs start with the session, one per core at a time (``background``). They run in pytest's own
+process (``--conformance-isolation none``): the kit's own syncs do not crash, and a process of
+pytest-xdist's for each of the 29 runs cost 2.5 s of CPU more a run (measured: ``wrong_syncs:OneStepLate``
+with ``-x``, 5.6 s against 3.2 s); ``tests/test_crashes.py`` shows the isolation a user's sync gets.
 """
 
 from __future__ import annotations
@@ -40,7 +43,7 @@ WHERE = re.compile(r"\[(?P<scene>[A-Za-z_][A-Za-z0-9_]*)(?:\(.*?\))?, frame (?P<
 
 def _describe(outcome: verdicts.Outcome, stop_at_first: bool) -> str:
     failures = "\n".join(f"  {r['check']} [{r['scene']}]: {r['message'][:400]}" for r in outcome.failed[:3])
-    argv = verdicts.command(outcome.spec, stop_at_first=stop_at_first)
+    argv = verdicts.command(outcome.spec, stop_at_first=stop_at_first, pytest_args=background.OWN_SYNCS)
     return (f"`PYTHONPATH=tests {' '.join(argv[1:])}` exited {outcome.exitstatus}; "
             f"{len(outcome.failed)} checks failed{':' if failures else '.'}\n{failures}\n{outcome.stderr[-800:]}")
 
@@ -54,7 +57,8 @@ def _env() -> dict[str, str]:
 
 def _run(spec: str, stop_at_first: bool):
     """The run of ``spec`` (key and callable for :mod:`background`)."""
-    return f"discrimination:{spec}", lambda: verdicts.check(spec, stop_at_first=stop_at_first, env=_env())
+    return f"discrimination:{spec}", lambda: verdicts.check(spec, stop_at_first=stop_at_first, env=_env(),
+                                                            pytest_args=background.OWN_SYNCS)
 
 
 def background_runs(items) -> dict:

@@ -34,7 +34,7 @@ def _env() -> dict[str, str]:
 
 def _sync_run(spec: str, seed: int):
     return (f"random-draws:{spec}:{seed}",
-            lambda: verdicts.check(spec, pytest_args=precision.pytest_args(seed), env=_env()))
+            lambda: verdicts.check(spec, pytest_args=[*precision.pytest_args(seed), *background.OWN_SYNCS], env=_env()))
 
 
 def _app_run(path: Path, seed: int):
