@@ -12,7 +12,7 @@ import conformance.test_vertices  # noqa: F401
 import PIL.Image  # noqa: F401
 import pytest
 
-pytest_plugins = ["pytester"]
+pytest_plugins = ["pytester", "tiers"]  # tiers: the fast tier (CI) and --full
 
 # `./kit test` runs these tests with the variable `./kit` sets for its commands; the commands the kit
 # prints then name the kit's interpreter (conformance.sync.printed). The tests read those lines as a user who

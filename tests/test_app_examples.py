@@ -67,6 +67,7 @@ def test_agreement_needs_the_check_and_the_diagnosis(tmp_path, expected, passed,
     assert examples._agrees(expectation, passed, failed) is agrees
 
 
+@pytest.mark.full("a whole app-table run over example apps: the table tool's own test; CI runs every example app (test_examples)")
 def test_app_table_writes_the_table_and_fails_on_a_disagreement(tmp_path):
     late = SOURCE.replace(STEP, "").replace("    showm.render()\n", "    showm.render()\n" + STEP)
     assert late != SOURCE

@@ -33,6 +33,7 @@ def _cli(*args):
                           timeout=600)
 
 
+@pytest.mark.full("whole app runs in processes of their own; CI judges app mode end to end on every example app (test_examples)")
 def test_a_right_app_passes_every_check_and_its_perturbed_runs():
     done = _cli(APP, "--perturbed", "1")
     assert done.returncode == 0, done.stdout + done.stderr
@@ -135,6 +136,7 @@ def test_an_app_the_kit_cannot_run_gets_one_paragraph(tmp_path, change, needle):
     assert "Traceback (most recent call last)" not in message.split("\n")[0]
 
 
+@pytest.mark.full("waits out an app's 20 s timeout: robustness, not discrimination")
 def test_an_app_that_hangs_is_stopped_at_the_timeout(tmp_path):
     hangs = SOURCE.replace(STEP, STEP + "    import time; time.sleep(600) if cnt == 2 else None\n")
     with pytest.raises(apps.AppFailed, match="did not finish 10 ticks within 20 s"):
@@ -148,6 +150,7 @@ def test_an_app_raising_in_its_callback_fails_runs(tmp_path):
     assert "the app raised at tick 5: RuntimeError: lost the body" in result.verdicts["runs"].message()
 
 
+@pytest.mark.full("whole app runs in processes of their own; CI judges app mode end to end on every example app (test_examples)")
 def test_apps_in_the_ini_are_checked_one_id_per_check(pytester):
     pytester.makefile(".py", app=SOURCE)
     # The app's mapping beside it is matched by the glob, and is not an app.
@@ -193,6 +196,7 @@ ANNOUNCE_POSITIONS = "        balls.geometry.positions.update_range(i * sec, sec
                                                         ".update_range(i * sec, sec)\n"),
      r"at tick 1 its positions changed at vertices 0–\d+ \(\d+ of them\), outside every range announced"),
 ])
+@pytest.mark.full("whole app runs in processes of their own; CI judges app mode end to end on every example app (test_examples)")
 def test_every_buffer_and_range_an_app_changes_is_announced(tmp_path, change, needle):
     import re
 

@@ -263,6 +263,7 @@ def test_an_actor_hidden_for_a_while_is_seen_in_a_picture_during_the_run(tmp_pat
 HIDE_SECOND = {"vtk": "    pairs[1][2].SetVisibility(cnt < 20)\n", "pygfx": "    pairs[1][2].visible = cnt < 20\n"}
 
 
+@pytest.mark.full("whole app runs in processes of their own; CI judges app mode end to end on every example app (test_examples)")
 def test_bodies_of_every_client_are_in_pyBullets_picture(tmp_path):
     """Each pyBullet client is a world of its own, which an app may draw in one scene: pyBullet's picture
     is every client's, put together by its depth buffer. (With the first client's only, this right app's

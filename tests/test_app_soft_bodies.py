@@ -10,6 +10,7 @@ from pathlib import Path
 
 import pybullet
 import pybullet_data
+import pytest
 
 from conformance import apps, backends
 from conformance.apps import bodies, perturbed
@@ -44,6 +45,7 @@ def test_a_soft_bodys_nodes_are_frames_with_a_position_and_no_turn():
         pybullet.disconnect(client)
 
 
+@pytest.mark.full("whole app runs in processes of their own; CI judges app mode end to end on every example app (test_examples)")
 def test_the_right_cloth_app_passes_its_own_run_and_a_perturbed_one():
     result = apps.check_app(CLOTH, ticks=60)
     assert result.passed, {k: v.message() for k, v in result.verdicts.items() if not v.passed}
@@ -51,6 +53,7 @@ def test_the_right_cloth_app_passes_its_own_run_and_a_perturbed_one():
     assert perturbed.search(CLOTH, examples=1) is None
 
 
+@pytest.mark.full("whole app runs in processes of their own; CI judges app mode end to end on every example app (test_examples)")
 def test_a_cloth_copied_before_the_step_is_one_step_late(tmp_path):
     late = SOURCE.replace(STEP, "    sync()\n    p.stepSimulation()\n")
     assert late != SOURCE
@@ -99,6 +102,7 @@ def test_the_right_cloth_is_pictured_where_pybullet_draws_it():
     assert len(cloth) == len([p for p in verdict.pictures]) and all(t["iou"] >= 0.98 for t in cloth), cloth
 
 
+@pytest.mark.full("whole app runs in processes of their own; CI judges app mode end to end on every example app (test_examples)")
 def test_a_cloth_whose_triangles_join_other_nodes_is_not_pictured(tmp_path):
     """Every vertex on its node, every node followed, the triangles made for the nodes sorted by np.unique:
     no vertex check can see it; the picture does (``face-order``)."""
@@ -111,6 +115,7 @@ def test_a_cloth_whose_triangles_join_other_nodes_is_not_pictured(tmp_path):
     assert "soft body 0 (cloth_z_up) is not where pyBullet's renderer draws it" in verdicts["pictured"].message()
 
 
+@pytest.mark.full("whole app runs in processes of their own; CI judges app mode end to end on every example app (test_examples)")
 def test_a_soft_ball_whose_normals_follow_its_shape_passes():
     """A right program recomputes a deforming surface's normals every tick; a node has no turn for them to
     follow, so ``normals`` leaves them out with a note instead of rejecting the right ball with

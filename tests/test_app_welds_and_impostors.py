@@ -6,6 +6,7 @@ in ``wrong/`` (``tests/test_examples.py``)."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from scipy.spatial.transform import Rotation
 
 import app_recordings as rec
@@ -91,6 +92,7 @@ def test_a_note_names_the_ranges_a_frame_holds_not_one_range_over_them():
     assert _ranges(np.array([0, 2, 4, 6, 8])) == "0:1, 2:3, 4:5 and 2 more ranges"
 
 
+@pytest.mark.full("whole app runs in processes of their own; CI judges app mode end to end on every example app (test_examples)")
 def test_every_note_is_shown_on_asking(tmp_path):
     """``app --notes all`` prints every note of every check; by default a check's notes past three are
     counted, and the count says how to see them (before, '… 26 more notes' and nothing showed them)."""

@@ -44,6 +44,7 @@ def wrapped(monkeypatch):
     ("brick_wall_single", "right_syncs:IncrementalSync"),
     ("pendulum", "right_syncs:PositionOrientationSync"),
 ])
+@pytest.mark.full("whole app runs in processes of their own; CI judges app mode end to end on every example app (test_examples)")
 def test_right_syncs_wrapped_as_apps_pass(wrapped, scene, sync):
     result = wrapped(scene, sync)
     assert result.passed, "\n".join(v.message() for v in result.verdicts.values() if not v.passed)
@@ -63,6 +64,7 @@ def test_right_syncs_wrapped_as_apps_pass(wrapped, scene, sync):
     # pygfx turn with its matrix)
     ("mixed_shapes:by_kind", "wrong_syncs:NormalsNotRotated", "normals", "stale-normals"),
 ])
+@pytest.mark.full("whole app runs in processes of their own; CI judges app mode end to end on every example app (test_examples)")
 def test_wrong_syncs_wrapped_as_apps_fail_with_their_diagnosis(wrapped, scene, sync, check, diagnosis):
     scene, _, grouping = scene.partition(":")
     result = wrapped(scene, sync, {"grouping": grouping} if grouping else None)

@@ -316,6 +316,7 @@ def test_app_mode_figures_are_per_tick_against_the_apps_own_tick():
     assert [name for name, _, _ in app_mode.apps(backends.NAME)][-1].startswith("1,000 boxes in one actor")
 
 
+@pytest.mark.full("times two whole app runs: a benchmark of the kit, not discrimination")
 def test_a_failing_robots_verdict_is_timed_against_the_passing_one():
     """The figure is the failing verdict's wall time over the passing one's, measured in the same run; the
     report says the target (issue 29: at most twice)."""

@@ -131,6 +131,7 @@ with runner.running("free_fall", sync.load("reference")) as run:
 
 
 @pytest.mark.parametrize("signum", [signal.SIGTERM, signal.SIGKILL], ids=["SIGTERM", "SIGKILL"])
+@pytest.mark.full("kills whole kit runs and waits for their processes to go: robustness, not discrimination")
 def test_a_process_that_started_the_display_leaves_no_xvfb(tmp_path, signum):
     process = _start([sys.executable, "-c", RENDER_AND_WAIT], tmp_path)
     said = []
@@ -154,6 +155,7 @@ def _pytest(tmp_path, *args: str) -> subprocess.Popen:
 
 
 @pytest.mark.parametrize("signum", [signal.SIGTERM, signal.SIGKILL], ids=["SIGTERM", "SIGKILL"])
+@pytest.mark.full("kills whole kit runs and waits for their processes to go: robustness, not discrimination")
 def test_a_pytest_run_leaves_no_xvfb(tmp_path, signum):
     process = _pytest(tmp_path)
     xvfbs = _wait_for_xvfbs(process, 1)
@@ -163,6 +165,7 @@ def test_a_pytest_run_leaves_no_xvfb(tmp_path, signum):
 
 
 @pytest.mark.parametrize("signum", [signal.SIGTERM, signal.SIGKILL], ids=["SIGTERM", "SIGKILL"])
+@pytest.mark.full("kills whole kit runs and waits for their processes to go: robustness, not discrimination")
 def test_killing_the_xdist_controller_leaves_no_worker_and_no_xvfb(tmp_path, signum):
     pytest.importorskip("xdist")
     process = _pytest(tmp_path, "-n", "2")
@@ -217,6 +220,7 @@ def test_a_handler_someone_else_installed_is_left_alone(own_display):
 
 
 @pytest.mark.parametrize("signum", [signal.SIGTERM, signal.SIGKILL], ids=["SIGTERM", "SIGKILL"])
+@pytest.mark.full("kills whole kit runs and waits for their processes to go: robustness, not discrimination")
 def test_the_run_command_leaves_no_pytest_and_no_xvfb(tmp_path, signum):
     """``python -m conformance run`` starts pytest as a child: killing the command ends that run too."""
     process = _start([sys.executable, "-m", "conformance", "run", "-q", "-k", "test_golden_render"], tmp_path)

@@ -64,7 +64,11 @@ def _outcomes(records) -> dict:
     return {row["nodeid"].split("::")[-1]: row["outcome"] for row in records}
 
 
-@pytest.mark.parametrize("workers", [[], ["-n", "2"]], ids=["serial", "xdist"])
+@pytest.mark.parametrize("workers", [
+    pytest.param([], id="serial"),  # in CI: the isolation every user's sync gets (the kit's own runs skip it)
+    pytest.param(["-n", "2"], id="xdist", marks=pytest.mark.full(
+        "a second whole run made to crash, under -n: robustness of the isolation, not discrimination")),
+])
 def test_a_segfault_fails_its_check_with_where_it_was_and_the_run_goes_on(run, workers):
     result, records, text = run("crashing_syncs:SegfaultsOnFreeFall", *workers)
     assert result.ret == pytest.ExitCode.TESTS_FAILED, text
@@ -95,6 +99,7 @@ def test_a_segfault_fails_its_check_with_where_it_was_and_the_run_goes_on(run, w
 
 @pytest.mark.parametrize("sync, how", [("AbortsOnFreeFall", "killed by SIGABRT"),
                                        ("ExitsOnFreeFall", "exit status 3, without a Python error")])
+@pytest.mark.full("a whole kit run made to crash, hang or stop: robustness of the isolation, not discrimination")
 def test_an_abort_or_an_exit_is_a_verdict_too(run, sync, how):
     result, records, text = run(f"crashing_syncs:{sync}")
     assert result.ret == pytest.ExitCode.TESTS_FAILED, text
@@ -102,6 +107,7 @@ def test_an_abort_or_an_exit_is_a_verdict_too(run, sync, how):
     assert _outcomes(records)["test_vertices_match_poses_every_frame[sliding_box]"] == "passed", text
 
 
+@pytest.mark.full("a whole kit run made to crash, hang or stop: robustness of the isolation, not discrimination")
 def test_a_loop_in_c_that_the_alarm_cannot_stop_is_stopped_by_the_watchdog(run):
     """A call looping inside C never sees the per-call alarm; the controller stops its worker at twice the
     limit and 5 s more (here 1 s: 7 s), and the check fails saying so, where it was, and the run goes on."""
@@ -112,6 +118,7 @@ def test_a_loop_in_c_that_the_alarm_cannot_stop_is_stopped_by_the_watchdog(run):
     assert _outcomes(records)["test_vertices_match_poses_every_frame[sliding_box]"] == "passed", text
 
 
+@pytest.mark.full("a whole kit run made to crash, hang or stop: robustness of the isolation, not discrimination")
 def test_a_right_sync_of_the_users_is_isolated_and_passes(run):
     result, records, text = run("conformance.implementations.reference:ReferenceSync")
     assert result.ret == pytest.ExitCode.OK, text
@@ -125,6 +132,7 @@ def test_without_isolation_a_crash_ends_the_run_as_it_would_without_the_kit(run)
     assert records == []
 
 
+@pytest.mark.full("a whole kit run made to crash, hang or stop: robustness of the isolation, not discrimination")
 def test_x_stops_at_the_first_failure_with_pytests_own_exit_status(run):
     result, records, text = run("crashing_syncs:SegfaultsOnFreeFall", "-x")
     assert result.ret == pytest.ExitCode.TESTS_FAILED, text  # not xdist's INTERRUPTED

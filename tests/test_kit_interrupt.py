@@ -9,6 +9,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from conformance.backends.display import child_environment
 
 TESTS = Path(__file__).resolve().parent
@@ -21,6 +23,7 @@ def _hear_ctrl_c():
     signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
+@pytest.mark.full("a whole run interrupted by Ctrl-C: robustness of the summary, not discrimination")
 def test_ctrl_c_on_run_ends_with_the_summary_and_no_traceback(tmp_path):
     environment = {**child_environment(), "PYTHONPATH": os.pathsep.join([str(TESTS), os.environ.get("PYTHONPATH", "")])}
     # A session of its own: the sync's Ctrl-C goes to this run's process group, as a terminal's does.

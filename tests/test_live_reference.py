@@ -175,6 +175,7 @@ OTHER_RENDERERS = {
 
 @pytest.mark.skipif(backends.NAME != "vtk", reason="softpipe and zink are OpenGL drivers: FURY 0.12 only")
 @pytest.mark.parametrize("name", OTHER_RENDERERS)
+@pytest.mark.full("whole runs on Mesa's other OpenGL drivers: the renderer's portability, not discrimination")
 def test_on_another_renderer_the_reference_passes_and_a_wrong_sync_fails_the_sync_verdict_alone(tmp_path, name):
     variables, chosen = OTHER_RENDERERS[name]
     variables = {k: v if v is not None else str(tmp_path) for k, v in variables.items()}

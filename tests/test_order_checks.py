@@ -49,6 +49,7 @@ def failures(spec: str) -> dict[str, str]:
 
 
 @pytest.mark.parametrize("spec", [pytest.param(s, id=s.partition(":")[2]) for s in WRONG])
+@pytest.mark.full("the same verdict as CI's kill-rate runs (test_discrimination), which run every right and order sync through the sync-order machine")
 def test_the_machine_kills_an_order_dependent_mistake(spec, triage):
     found = failures(spec)
     assert found, f"the sync-order check should fail {spec} on some scene of {order.SCENES}, but passed it on all"
@@ -57,6 +58,7 @@ def test_the_machine_kills_an_order_dependent_mistake(spec, triage):
 
 
 @pytest.mark.parametrize("spec", [pytest.param(s, id=s.partition(":")[2] or s) for s in RIGHT])
+@pytest.mark.full("the same verdict as CI's kill-rate runs (test_discrimination), which run every right and order sync through the sync-order machine")
 def test_the_machine_passes_a_right_sync(spec, triage):
     found = failures(spec)
     assert not found, f"the sync-order check should pass the right sync {spec}, but failed: {found}"

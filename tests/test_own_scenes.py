@@ -67,6 +67,7 @@ def test_regen_writes_the_goldens_beside_the_scene_file_not_into_the_kit(project
     assert not (golden.default_dir() / "tossed_die").exists()
 
 
+@pytest.mark.full("whole kit runs on a user's own scenes: a feature end to end, not one of CI's guarantees")
 def test_one_run_checks_the_kit_s_scenes_and_yours_each_against_its_own_goldens(project):
     run = _run(project, "-m", "pytest", "--pyargs", "conformance", "-p", "no:cacheprovider", "-q",
                "--conformance-scenes", "my_scenes.py", "-k", "tossed_die or (golden and free_fall)")
@@ -99,6 +100,7 @@ def test_a_missing_golden_names_the_whole_command_that_makes_it(project, tmp_pat
     assert (tmp_path / "tossed_die" / "frame-0000.png").is_file()
 
 
+@pytest.mark.full("whole kit runs on a user's own scenes: a feature end to end, not one of CI's guarantees")
 def test_a_failing_check_reproduces_as_printed_from_the_same_directory(project):
     wrong = {"PYTHONPATH": str(TESTS)}
     run = _run(project, "-m", "pytest", "--pyargs", "conformance", "-p", "no:cacheprovider", "-q",
@@ -111,6 +113,7 @@ def test_a_failing_check_reproduces_as_printed_from_the_same_directory(project):
     assert replay.returncode == 1 and "FAIL tossed_die" in replay.stdout, replay.stdout + replay.stderr
 
 
+@pytest.mark.full("whole kit runs on a user's own scenes: a feature end to end, not one of CI's guarantees")
 def test_a_changed_scene_s_physics_failure_blames_the_scene_and_its_command_runs(project, tmp_path):
     """Issue 30, point 2: it said "this is pyBullet or the platform" and printed a regen command
     without ``--scenes``, which failed with "scene='tossed_die', but should be one of: ..."."""
@@ -156,6 +159,7 @@ def test_a_golden_made_for_another_camera_is_said_once_naming_what_changed(proje
     assert len(said) == 1, run.stdout[-3000:]
 
 
+@pytest.mark.full("whole kit runs on a user's own scenes: a feature end to end, not one of CI's guarantees")
 def test_regen_refuses_a_camera_that_cuts_a_body_off(project, tmp_path):
     """Issue 30, point 9: regen made goldens of a camera that cut the die off; only the next run's
     framing check said so, as an ``assert False`` traceback of the kit's source."""

@@ -82,6 +82,7 @@ def test_draw_seeds_follow_the_commit_or_the_variable(monkeypatch, tmp_path):
     assert precision.draw_seed(tmp_path) == (123, "$KIT_DRAW_SEED")
 
 
+@pytest.mark.full("a precision run of a wrong sync end to end: the tool's own test; CI's random-draw slice runs the same code on right syncs")
 def test_precision_reports_a_wrong_sync_as_a_false_alarm_with_its_replay_line(tmp_path):
     """End to end, as its users run it; a sync one step late stands for a false alarm (the command cannot
     tell a wrong sync from a wrong check: every failure of a right sync is an alarm), and its replay
@@ -103,6 +104,7 @@ def test_precision_reports_a_wrong_sync_as_a_false_alarm_with_its_replay_line(tm
     assert again.returncode == 1 and "failed" in again.stdout, again.stdout[-2000:]
 
 
+@pytest.mark.full("a precision run end to end: the tool's own test; CI's random-draw slice runs the same code on right syncs")
 def test_checks_gives_only_the_checks_it_picks_their_runs(tmp_path):
     """``--checks EXPR`` runs only what ``pytest -k EXPR`` picks of the drawing checks (how the checks that
     draw their own scene get thousands of runs cheaply), says so in the table, and keeps it in the made-by line."""

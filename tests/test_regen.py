@@ -263,6 +263,7 @@ def test_missing_golden_fails_with_the_command_that_makes_it(tmp_path):
     assert not list(empty.iterdir()), "a check wrote a golden without being asked"
 
 
+@pytest.mark.full("a whole regeneration under -n 2: a race of the tool, not one of CI's guarantees")
 def test_regen_golden_option_under_xdist_does_not_race(tmp_path, made):
     pytest.importorskip("xdist", reason="pytest-xdist is a dev dependency; without it -n cannot be tried")
     directory = tmp_path / "golden"

@@ -105,6 +105,7 @@ def test_readme_without_the_markers_is_a_clear_error_and_is_left_alone(tmp_path)
         replace_block(str(tmp_path / "missing.md"), "verdicts", "| t |")
 
 
+@pytest.mark.full("whole `run` commands with wrong and right syncs: the command's exit status end to end, not one of CI's guarantees")
 def test_run_command_is_pytest_on_the_kit_and_says_so_in_its_exit_status(monkeypatch, capfd):
     """``python -m conformance run`` (what ``./kit run`` calls): 0 for a right sync, 1 for a wrong one,
     and no warning that the kit could not be assert-rewritten."""

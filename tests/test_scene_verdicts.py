@@ -30,6 +30,7 @@ def table(pytester, monkeypatch):
 
 
 @pytest.mark.parametrize("isolation", ["auto", "none"])
+@pytest.mark.full("whole kit runs stopped or run to the end to read the per-scene verdict lines: printing, not discrimination")
 def test_a_run_stopped_by_x_calls_no_scene_it_did_not_finish_pass(table, isolation):
     result, rows, text = table("--sync", "wrong_syncs:OneStepLate", "-x", "--conformance-isolation", isolation)
     assert result.ret == pytest.ExitCode.TESTS_FAILED, text
@@ -39,6 +40,7 @@ def test_a_run_stopped_by_x_calls_no_scene_it_did_not_finish_pass(table, isolati
     assert all(verdict == "FAIL" or "checks not run" in detail for verdict, detail in rows.values()), text
 
 
+@pytest.mark.full("whole kit runs stopped or run to the end to read the per-scene verdict lines: printing, not discrimination")
 def test_an_interrupted_run_calls_no_scene_it_did_not_finish_pass(table):
     """Ctrl-C while a sync runs (the sync raises KeyboardInterrupt at free_fall's 50th call)."""
     result, rows, text = table("--sync", "hanging_syncs:InterruptedOnFreeFall", "--conformance-isolation", "none")
@@ -47,6 +49,7 @@ def test_an_interrupted_run_calls_no_scene_it_did_not_finish_pass(table):
     assert any(verdict in ("INCOMPLETE", "NOT RUN") for verdict, _ in rows.values()), text
 
 
+@pytest.mark.full("whole kit runs stopped or run to the end to read the per-scene verdict lines: printing, not discrimination")
 def test_a_whole_run_calls_its_scenes_pass(table):
     result, rows, text = table("--sync", "reference")
     assert result.ret == pytest.ExitCode.OK, text

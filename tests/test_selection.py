@@ -30,6 +30,7 @@ def _collected(*args: str) -> list[str]:
 
 
 @pytest.mark.parametrize("n", [2, 3])
+@pytest.mark.full("whole runs split into shards: tooling, not discrimination")
 def test_shards_run_every_check_exactly_once(n):
     everything = _collected()
     shards = [_collected("--shard", f"{k}/{n}") for k in range(1, n + 1)]
@@ -38,6 +39,7 @@ def test_shards_run_every_check_exactly_once(n):
     assert max(map(len, shards)) - min(map(len, shards)) <= 1, [len(s) for s in shards]
 
 
+@pytest.mark.full("whole runs split into shards: tooling, not discrimination")
 def test_shards_split_what_k_selected():
     chain = _collected("-k", "chain")
     halves = _collected("-k", "chain", "--shard", "1/2") + _collected("-k", "chain", "--shard", "2/2")

@@ -7,6 +7,8 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+import pytest
+
 from conformance.discrimination import verdicts
 
 TESTS = Path(__file__).resolve().parent
@@ -53,6 +55,7 @@ class Sync(ReferenceSync):
         assert "raised on scene 'free_fall' at step 5: RuntimeError: lost the actor" in record["message"], record["message"]
 
 
+@pytest.mark.full("a whole run of a right sync: CI's kill-rate runs pass every right sync through every check")
 def test_a_right_sync_passes_every_check_of_the_shared_run(tmp_path):
     records = _outcomes("from right_syncs import IncrementalSync as Sync\n", tmp_path, "sync_under_test:Sync", "chain")
     assert set(records) == set(SHARING) and all(r["outcome"] == "passed" for r in records.values()), records

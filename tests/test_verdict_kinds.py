@@ -240,6 +240,7 @@ def guide_vertex_runs():
             for survey_mode in (True, False)}
 
 
+@pytest.mark.full("a survey run of the guide's syncs: the verdicts tool's own test, not one of CI's guarantees")
 def test_verdicts_shows_the_guide_vertex_drift_its_normals_failure_hid(guide_vertex_runs):
     surveyed, default = guide_vertex_runs[True], guide_vertex_runs[False]
     assert surveyed.exitstatus == 1 and len(surveyed.records) == 1, surveyed.stderr

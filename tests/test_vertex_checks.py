@@ -62,6 +62,7 @@ def test_orientation_check_fails_at_gimbal_lock():
     checks.check_run(kit("right_syncs:PositionOrientationSync"), "free_fall", {}, 0, events)
 
 
+@pytest.mark.full("10,000 frames of a float32 sync to show the drift check alone fails it; in CI the kill rate rejects the same sync (wrong_syncs:Float32Incremental, test_discrimination)")
 def test_drift_check_fails_on_float32_increments():
     with pytest.raises(Failed, match=r"tumbling\(.*frame \d+"):
         checks.test_no_drift_over_ten_thousand_frames(kit("wrong_syncs:Float32Incremental"))
