@@ -103,3 +103,5 @@ def test_the_fast_tier_leaves_out_full_tests_and_says_so(pytester):
     fast.stdout.fnmatch_lines(["tier: fast*--full*", "*test_quick PASSED*"])
     full = pytester.runpytest("-p", "no:randomly", "--full")
     full.assert_outcomes(passed=2)
+    asked = pytester.runpytest("-p", "no:randomly", "test_some.py::test_slow")  # named by its node id: it runs
+    asked.assert_outcomes(passed=1)

@@ -26,13 +26,22 @@ def pytest_configure(config: pytest.Config) -> None:
 @pytest.hookimpl(tryfirst=True)
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     """Without ``--full``, the tests marked ``full`` are deselected, as ``-m 'not full'`` would (a user's own
-    ``-m`` still applies)."""
+    ``-m`` still applies), but for a test named by its node id (``file.py::test_name``): asked for, it runs."""
     if config.getoption("full"):
         return
-    left_out = [item for item in items if item.get_closest_marker("full")]
+    named = [arg.replace("\\", "/") for arg in config.args if "::" in arg]
+    left_out = [item for item in items if item.get_closest_marker("full") and not any(_names(n, item.nodeid) for n in named)]
     if left_out:
         config.hook.pytest_deselected(items=left_out)
-        items[:] = [item for item in items if not item.get_closest_marker("full")]
+        gone = set(map(id, left_out))
+        items[:] = [item for item in items if id(item) not in gone]
+
+
+def _names(arg: str, nodeid: str) -> bool:
+    """Whether the command-line argument ``arg`` names the test ``nodeid`` (from any directory; without
+    a ``[param]``, every parameter of it)."""
+    test = nodeid if "[" in arg else nodeid.split("[")[0]
+    return arg == test or arg.endswith("/" + test) or test.endswith("/" + arg)
 
 
 def pytest_report_header(config: pytest.Config) -> list[str]:
