@@ -85,14 +85,39 @@ def _transposed_times(rotations: np.ndarray, vectors: np.ndarray) -> np.ndarray:
             + vectors[..., 2, None] * rotations[..., 2, :])
 
 
+def _in_frames(vertices: np.ndarray, pos: np.ndarray, rot: np.ndarray, best: np.ndarray, rows=None) -> np.ndarray:
+    """``(T, m, 3)``: the vertices ``rows`` (all by default) in their frames ``best[rows]`` at every tick, one
+    matrix product per frame: a ``(T, n, 3, 3)`` stack of each vertex's rotation, gathered, cost 4.5 times
+    as much on a racecar's 30,000-vertex chassis (``(R^T d)^T = d^T R``)."""
+    rows = np.arange(len(best)) if rows is None else np.asarray(rows)
+    frames = best[rows]
+    local = np.empty((vertices.shape[0], len(rows), 3))
+    for f in np.unique(frames):
+        mine = np.flatnonzero(frames == f)
+        local[:, mine] = (vertices[:, rows[mine]] - pos[:, f, None, :]) @ rot[:, f]
+    return local
+
+
+def _lengths(d: np.ndarray) -> np.ndarray:
+    """Euclidean lengths over the last axis (``np.linalg.norm``'s, six times as fast on these stacks)."""
+    return np.sqrt(np.einsum("...i,...i->...", d, d))
+
+
+def _errors(local: np.ndarray) -> np.ndarray:
+    """``(m, T)``: each vertex's distance from its median coordinates, at every tick."""
+    return _lengths(local - np.median(local, axis=0)).T
+
+
 def _spreads(vertices, positions, rotations, candidates, probes):
     """Largest change of each vertex's coordinates over the ``probes`` ticks, in each candidate frame:
-    ``(n, k)`` for ``candidates`` ``(n, k)`` frame indices."""
-    v = vertices[probes][:, :, None, :]                        # (P, n, 1, 3)
-    p = positions[probes][:, candidates]                       # (P, n, k, 3)
-    r = rotations[probes][:, candidates]                       # (P, n, k, 3, 3)
-    local = _transposed_times(r, v - p)
-    return np.max(np.linalg.norm(local - local[:1], axis=-1), axis=0)
+    ``(n, k)`` for ``candidates`` ``(n, k)`` frame indices (computed frame by frame, as :func:`_in_frames`)."""
+    v, p, r = vertices[probes], positions[probes], rotations[probes]
+    out = np.empty(candidates.shape)
+    for f in np.unique(candidates):
+        rows, cols = np.nonzero(candidates == f)
+        local = (v[:, rows] - p[:, f, None, :]) @ r[:, f]
+        out[rows, cols] = np.max(_lengths(local - local[:1]), axis=0)
+    return out
 
 
 def _probes(ticks: int, extra=()) -> np.ndarray:
@@ -167,8 +192,14 @@ def attach(vertices: np.ndarray, positions: np.ndarray, rotations: np.ndarray, *
         if k >= frames:
             break
     tied = np.sum(spreads <= np.maximum(allowance, 1e-12)[:, None], axis=1) > 1 if n else np.zeros(0, dtype=bool)
-    local = local_coordinates(vertices, pos[:, best], rot[:, best])
-    error = np.linalg.norm(local - np.median(local, axis=0), axis=-1).T
+    local = _in_frames(vertices, pos, rot, best)
+    error = _errors(local)
+
+    def again_in(rows):
+        """Recompute ``local`` and ``error`` of the ``rows`` whose frame changed."""
+        local[:, rows] = _in_frames(vertices, pos, rot, best, rows)
+        error[rows] = _errors(local[:, rows])
+
     # The frame was chosen on the probe ticks, where two frames may both hold a vertex (the corner where two
     # resting bricks touch lies on both shapes) though only one holds it at every tick: choose those again
     # on every tick (measured on FURY's own wrecking-ball demo: single corners "not held" 1e-13 m from their brick).
@@ -178,23 +209,21 @@ def attach(vertices: np.ndarray, positions: np.ndarray, rotations: np.ndarray, *
         found = spreads_of(loose, again, np.arange(ticks))
         best[loose] = again[np.arange(len(loose)), np.argmin(found, axis=1)]
         allowance = _allowance(vertices, pos, rot, best, tolerance)
-        local = local_coordinates(vertices, pos[:, best], rot[:, best])
-        error = np.linalg.norm(local - np.median(local, axis=0), axis=-1).T
+        again_in(loose)
     welded = np.zeros(n, dtype=bool)
     if groups is not None and n and frames:
+        before = best
         best, welded = _on_welded_shape(vertices[0], pos[0], rot[0], best, np.asarray(groups), centres, radii, outside)
         if welded.any():
             tied = tied & ~welded
             allowance = _allowance(vertices, pos, rot, best, tolerance)
-            local = local_coordinates(vertices, pos[:, best], rot[:, best])
-            error = np.linalg.norm(local - np.median(local, axis=0), axis=-1).T
+            again_in(np.flatnonzero(best != before))
     if n and frames:
         moved = _with_the_majority(vertices, pos, rot, best, welded, allowance, error, tolerance, outside)
         if moved.any():
             tied = tied & ~moved
             allowance = _allowance(vertices, pos, rot, best, tolerance)
-            local = local_coordinates(vertices, pos[:, best], rot[:, best])
-            error = np.linalg.norm(local - np.median(local, axis=0), axis=-1).T
+            again_in(np.flatnonzero(moved))
     reference = np.median(local, axis=0)
     frame = np.where(best == frames, -1, best)
     return Attachment(frame=frame, error=error, allowance=allowance, reference=reference, tied=tied, welded=welded)
@@ -225,8 +254,7 @@ def _with_the_majority(vertices, pos, rot, best, welded, allowance, error, toler
     trial = best.copy()
     trial[rows] = majority
     room = _allowance(vertices, pos, rot, trial, tolerance)[rows]
-    local = local_coordinates(vertices[:, rows], pos[:, trial[rows]], rot[:, trial[rows]])
-    spread = np.max(np.linalg.norm(local - np.median(local, axis=0), axis=-1), axis=0)
+    spread = np.max(_errors(_in_frames(vertices, pos, rot, trial, rows)), axis=1)
     ok = spread <= room
     moved = np.zeros(len(best), dtype=bool)
     moved[rows[ok]] = True
@@ -297,7 +325,7 @@ def _allowance(vertices, pos, rot, best, tolerance: Tolerance) -> np.ndarray:
     radius = np.linalg.norm(local0, axis=1)
     extent = np.zeros(pos.shape[1])
     np.maximum.at(extent, best, radius)
-    distance = np.max(np.linalg.norm(pos[:, best], axis=-1), axis=0)
+    distance = np.max(_lengths(pos), axis=0)[best]
     e = extent[best]
     return 2 * (tolerance.size_rtol * e + tolerance.position_rtol * (distance + e) + tolerance.atol)
 

@@ -19,6 +19,8 @@ Everything is computed from the :class:`~conformance.apps.recording.Recording` a
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from scipy.spatial.transform import Rotation
 
@@ -86,9 +88,28 @@ class _Judgement:
 
     def _reference(self, vertices, frame: int) -> np.ndarray:
         """Median coordinates ``(m, 3)`` of vertices ``(T, m, 3)`` in ``frame``."""
-        pos, rot = attach_mod._world(self.pos, self.rot)
-        f = np.full(vertices.shape[1], frame if frame >= 0 else pos.shape[1] - 1)
-        return np.median(attach_mod.local_coordinates(vertices, pos[:, f], rot[:, f]), axis=0)
+        pos, rot = self._with_world
+        f = frame if frame >= 0 else pos.shape[1] - 1
+        return np.median(attach_mod.local_coordinates(vertices, pos[:, f, None], rot[:, f, None]), axis=0)
+
+    @functools.cached_property
+    def _with_world(self) -> tuple[np.ndarray, np.ndarray]:
+        """The frames' positions and rotations at the judged ticks, the world appended as the last frame."""
+        return attach_mod._world(self.pos, self.rot)
+
+    @functools.cached_property
+    def _variants(self) -> list[tuple[np.ndarray, np.ndarray]]:
+        """Every frame's positions ``(T, F, 3)`` and rotations ``(T, F, 3, 3)`` under each mistake of the
+        catalogue (:data:`~conformance.apps.attachment.VARIANTS`, in its order): computed once for all frames,
+        not once for each loose piece and frame (a wrong 100-brick wall's diagnosis spent most of its time there)."""
+        before_pos, before_orn = self.r.before_positions[1:], self.r.before_orientations[1:]
+        return [tuple(np.asarray(a) for a in make(self.pos, self.orn, before_pos, before_orn))
+                for _, make in attach_mod.VARIANTS.values()]
+
+    @functools.cached_property
+    def _radii(self) -> np.ndarray:
+        """How far each frame's collision shapes reach from its origin (0 for a frame without)."""
+        return np.array([bounding_radius(f.shapes) if f.shapes else 0.0 for f in self.r.frames])
 
     def frame_label(self, index: int) -> str:
         return "the world" if index < 0 else self.r.frames[index].label
@@ -210,19 +231,16 @@ class _Judgement:
         mistakes = np.zeros(m, dtype=int)
         if not self.r.frames:
             return frames, mistakes
-        radius = np.array([bounding_radius(f.shapes) if f.shapes else 0.0 for f in self.r.frames])
+        radius = self._radii
         distance = np.linalg.norm(vertices[0][:, None, :] - self.pos[0][None, :, :], axis=-1)  # (m, F)
         near = distance <= 2 * radius[None, :] + 1e-9
         near[np.arange(m)[best >= 0], best[best >= 0]] = True
         score = np.full(m, np.inf)
-        before_pos, before_orn = self.r.before_positions[1:], self.r.before_orientations[1:]
         for f in np.flatnonzero(near.any(axis=0)):
             rows = np.flatnonzero(near[:, f])
-            idx = np.full(len(rows), f)
-            for k, (_, make) in enumerate(attach_mod.VARIANTS.values(), start=1):
-                positions, rotations = make(self.pos[:, idx], self.orn[:, idx], before_pos[:, idx], before_orn[:, idx])
-                local = attach_mod.local_coordinates(vertices[:, rows], np.asarray(positions), np.asarray(rotations))
-                error = np.linalg.norm(local - np.median(local, axis=0), axis=-1).max(axis=0) / allowance[rows]
+            for k, (positions, rotations) in enumerate(self._variants, start=1):
+                local = (vertices[:, rows] - positions[:, f, None]) @ rotations[:, f]
+                error = attach_mod._errors(local).max(axis=1) / allowance[rows]
                 better = (error <= 1.0) & (error < score[rows])
                 frames[rows[better]], mistakes[rows[better]], score[rows[better]] = f, k, error[better]
         return frames, mistakes
@@ -249,29 +267,23 @@ class _Judgement:
 
     def _errors(self, vertices, frame: int):
         """Error ``(m, T)`` and allowance ``(m,)`` of vertices ``(T, m, 3)`` held by ``frame``."""
-        m = vertices.shape[1]
-        pos, rot = attach_mod._world(self.pos, self.rot)
-        f = np.full(m, frame if frame >= 0 else pos.shape[1] - 1)
-        local = attach_mod.local_coordinates(vertices, pos[:, f], rot[:, f])
-        error = np.linalg.norm(local - np.median(local, axis=0), axis=-1).T
-        return error, attach_mod._allowance(vertices, pos, rot, f, self.tolerance)
+        pos, rot = self._with_world
+        index = frame if frame >= 0 else pos.shape[1] - 1
+        error = attach_mod._errors((vertices - pos[:, index, None]) @ rot[:, index])
+        return error, attach_mod._allowance(vertices, pos, rot, np.full(vertices.shape[1], index), self.tolerance)
 
     def _diagnose(self, vertices, frame, reference, allowance, bad_ticks) -> str:
         if frame < 0:
             return ""
-        m = vertices.shape[1]
-        f = np.full(m, frame)
-        before_pos = self.r.before_positions[1:][:, f]
-        before_orn = self.r.before_orientations[1:][:, f]
-        for name, (_, make) in attach_mod.VARIANTS.items():
-            positions, rotations = (np.asarray(a) for a in make(self.pos[:, f], self.orn[:, f], before_pos, before_orn))
+        for name, (positions, rotations) in zip(attach_mod.VARIANTS, self._variants):
+            positions, rotations = positions[:, frame, None], rotations[:, frame, None]
             if attach_mod.variant_fit(vertices, positions, rotations, reference, allowance, bad_ticks):
                 # A late sync is late wherever the body moved; drawn right at some of those ticks, it skipped
                 if name == "previous-step" and not attach_mod.variant_fit(
                         vertices, positions, rotations, reference, allowance, np.arange(len(vertices))):
                     return "skipped"
                 return name
-        return "skipped" if self._skipped(vertices, f, allowance) else ""
+        return "skipped" if self._skipped(vertices, frame, allowance) else ""
 
     def _skipped(self, vertices, f, allowance) -> bool:
         """Whether at every tick the vertices sit, in their frame, where they sat at one of the first ticks,
@@ -281,9 +293,8 @@ class _Judgement:
         ticks = len(vertices)
         if ticks < 3:
             return False
-        now = attach_mod.local_coordinates(vertices, self.pos[:, f], self.rot[:, f])
-        before = attach_mod.local_coordinates(vertices, self.r.before_positions[1:][:, f],
-                                              _rotations(self.r.before_orientations[1:][:, f]))
+        now = (vertices - self.pos[:, f, None]) @ self.rot[:, f]
+        before = (vertices - self.r.before_positions[1:][:, f, None]) @ _rotations(self.r.before_orientations[1:][:, f])
         for first in range(min(3, ticks)):
             right = np.all(np.linalg.norm(now - now[first], axis=-1) <= allowance, axis=1)
             late = np.all(np.linalg.norm(before - now[first], axis=-1) <= allowance, axis=1)
