@@ -1,16 +1,31 @@
-"""The kit's own tests. ``pytester`` runs the kit end to end in this process; modules with native
-extensions cannot be imported twice in one process, so everything the kit imports is imported here,
-before pytester snapshots ``sys.modules``."""
+"""The kit's own tests. ``pytester`` runs the kit end to end in this process, and after each run it
+removes from ``sys.modules`` what the run imported. So every module of the kit is imported here, before
+pytester snapshots ``sys.modules``: modules with native extensions cannot be imported twice in one process,
+and a kit module dropped and imported again splits its classes in two (measured: after a pytester run
+imported ``conformance.apps`` first, ``perturb.as_dict`` no longer knew the ``AfterStep`` that
+``perturbed.opening`` made, and ``test_app_wrapped`` failed with a KeyError)."""
 
-import conformance.cli  # noqa: F401
-import conformance.judge.compare  # noqa: F401
-import conformance.implementations.guide  # noqa: F401
-import conformance.checks.pytest_helpers  # noqa: F401
-import conformance.sync.runner  # noqa: F401
-import conformance.test_scenes  # noqa: F401
-import conformance.test_vertices  # noqa: F401
+import importlib
+import pkgutil
+
 import PIL.Image  # noqa: F401
 import pytest
+
+import conformance
+
+
+def _import_the_kit() -> None:
+    """Every module of ``conformance`` (the other FURY's backend modules excepted: their FURY is not here)."""
+    for module in pkgutil.walk_packages(conformance.__path__, "conformance."):
+        if module.name != "conformance.__main__":
+            try:
+                importlib.import_module(module.name)
+            except ModuleNotFoundError as exc:
+                if exc.name not in ("vtkmodules", "vtk", "fury", "pygfx", "wgpu"):
+                    raise
+
+
+_import_the_kit()
 
 pytest_plugins = ["pytester", "tiers"]  # tiers: the fast tier (CI) and --full
 
