@@ -75,6 +75,10 @@ def install(driver) -> None:
     """Patch FURY 2's window module so that the app's loop runs under ``driver``."""
     from fury import window
 
+    from conformance.backends import cffi_types
+
+    cffi_types.install()  # the app's pictures parse wgpu's types as the kit's do (a second of CPU a run)
+
     original_init = window.ShowManager.__init__
     original_close = window.ShowManager.close
     signature = inspect.signature(original_init)

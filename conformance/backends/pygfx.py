@@ -24,6 +24,7 @@ from typing import Any, Iterator
 
 import numpy as np
 
+from conformance.backends import cffi_types
 from conformance.backends.common import Drawing, decode_ids, id_codes, lay_out, moved_range, transformed, turned_normals
 from conformance.errors import BackendError
 from conformance.backends.renderer_start import WGPU_VARIABLES, asked_for, set_among
@@ -309,6 +310,7 @@ def _canvas_and_renderer(size: tuple[int, int]):
         raise BackendError(_start_error)
     if _canvas is None:
         os.environ.setdefault("XDG_RUNTIME_DIR", "/tmp")  # wgpu's Vulkan loader only warns without it
+        cffi_types.install()
         import pygfx
         from rendercanvas.offscreen import RenderCanvas
 
