@@ -148,23 +148,6 @@ def assert_vertices_match(results: Iterable[Any], *, run: Any, sync: str) -> Non
         pytest.fail(_vertices_message(failures, run, sync, drawn=_drawn(run, [_largest(failures)])), pytrace=False)
 
 
-def assert_normals_turn(results: Iterable[Any], *, run: Any, sync: str) -> None:
-    """Stored vertex normals turn with their body, so the body is lit as it is posed."""
-    __tracebackhide__ = True
-    failures = [r for r in results if not r.ok]
-    if failures:
-        pytest.fail(_normals_message(failures, run, sync), pytrace=False)
-
-
-def assert_changes_announced(run: Any, *, sync: str) -> None:
-    """Every change a sync makes to an actor's data is announced to the renderer (``Modified()``, ``update_range``), or a live
-    renderer keeps drawing the old vertices (FURY's ``utils.update_actor`` does this)."""
-    __tracebackhide__ = True
-    if run.unannounced:
-        frame, actor, missed = run.unannounced[0]
-        pytest.fail(_unannounced_message(frame, actor, missed, run, sync), pytrace=False)
-
-
 def assert_geometry_matches(results: Iterable[Any], *, scene: str, params: Mapping[str, Any], frame: int) -> None:
     """Every target is drawn as exactly its collision shape."""
     __tracebackhide__ = True
@@ -244,8 +227,8 @@ class Kit:
         results = compare.compare_vertices(run.drawing, run.frame, self.tolerance, frames=frames)
         self._record(results)
         sync = self.sync
-        # The same order and messages as assert_vertices_match, assert_normals_turn and
-        # assert_changes_announced: default mode raises the first of them, survey mode notes each.
+        # Vertices (with assert_vertices_match's message), then normals, then announcements: default mode
+        # raises the first of them, survey mode notes each.
         failures = [r for r in results if not r.ok]
         if failures:
             worst = max(failures, key=_by_ratio)

@@ -210,10 +210,6 @@ def restitutions(low: float = 0.5, high: float = 0.95) -> st.SearchStrategy[floa
     return st.floats(low, high, allow_nan=False, allow_subnormal=False)
 
 
-def frictions(low: float = 0.3, high: float = 1.0) -> st.SearchStrategy[float]:
-    return st.floats(low, high, allow_nan=False, allow_subnormal=False)
-
-
 def landing_steps(low: int = 60, high: int = 140) -> st.SearchStrategy[int]:
     """Drops that reach the plate exactly at the end of step n: the height is the integrator's own
     free-fall distance g·dt²·n(n+1)/2, so the impact is not split across a step (see
@@ -287,7 +283,7 @@ def crossing_parameters(**fixed) -> st.SearchStrategy[dict]:
 
 __all__ += [
     "FORCE_FRAMES", "bitmasks", "crossing_parameters", "damping_factors", "filter_modes", "force_frames", "free_bodies",
-    "forces", "frictions", "group_masks", "landing_steps", "lever_arms", "masses", "one_way_group_masks",
+    "forces", "group_masks", "landing_steps", "lever_arms", "masses", "one_way_group_masks",
     "restitutions", "shape_kinds", "sizes", "speed_gains", "spins", "substeps", "timesteps", "toggle_schedules", "torques",
     "velocities",
 ]

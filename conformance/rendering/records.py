@@ -54,10 +54,6 @@ class ImageCheck:
         if self.kind not in KINDS:
             raise ValueError(f"kind={self.kind!r}, but should be one of {KINDS}")
 
-    @property
-    def title(self) -> str:
-        return f"{self.kind} {self.scene} frame {self.frame}"
-
     def to_json(self) -> dict[str, Any]:
         return dataclasses.asdict(self)
 
