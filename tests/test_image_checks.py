@@ -126,6 +126,9 @@ def test_wrong_camera_fails_the_silhouette_check(wrong):
 @pytest.mark.parametrize("spec", ["reference", "right_syncs:PositionOrientationSync", "right_syncs:IncrementalSync",
                                   "right_syncs:vectorised_vertex_sync"])
 @pytest.mark.parametrize("scene", ["brick_wall_single", "chain", "free_fall", "pendulum", "mixed_shapes"])
+@pytest.mark.full("whole image runs whose verdict CI has: the kill-rate runs (test_discrimination) put each right sync "
+                  "through every golden and silhouette check of every scene, judged with the same-renderer set, "
+                  "and `pytest conformance` puts reference through them")
 def test_right_syncs_pass_every_image_check(spec, scene):
     """Right syncs in other styles pass even the tight same-renderer set: their float rounding, within
     the vertex tolerance, flips at most a few edge pixels (22 on mixed_shapes frame 360, against 40)."""
