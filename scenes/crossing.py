@@ -113,10 +113,6 @@ class Timeline:
         #: First frame at which the bounding spheres are apart again on the other side.
         self.separated = int(math.ceil((self.distance + self.reach) / closing)) + 1
 
-    def centre_distance(self, frame: int, speed: float) -> float:
-        """|x_b − x_a| at ``frame`` in free flight."""
-        return abs(self.distance - 2.0 * speed * self.dt * frame)
-
 
 def _fits(d) -> bool:
     """The pair meets after a few frames and is fully past each other well before the run ends."""
