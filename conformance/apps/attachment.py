@@ -33,7 +33,7 @@ from scipy.spatial.transform import Rotation
 from conformance.bullet import poses
 from conformance.judge.tolerances import DEFAULT, Tolerance
 
-__all__ = ["Attachment", "VARIANTS", "attach", "local_coordinates", "variant_fit"]
+__all__ = ["Attachment", "VARIANTS", "attach", "in_frame", "local_coordinates", "variant_fit"]
 
 #: nearest frames (by origin, at the first judged tick) tried first for each vertex, then more of
 #: them for a vertex none of those holds, then all of them (so a range following a far body is found)
@@ -85,6 +85,12 @@ def _transposed_times(rotations: np.ndarray, vectors: np.ndarray) -> np.ndarray:
             + vectors[..., 2, None] * rotations[..., 2, :])
 
 
+def in_frame(vertices: np.ndarray, positions: np.ndarray, rotations: np.ndarray) -> np.ndarray:
+    """``(T, m, 3)``: vertices ``(T, m, 3)`` in one frame, posed ``(T, 3)`` / ``(T, 3, 3)`` at each tick:
+    ``Rᵀ (v - p)`` as one matrix product a tick (``(Rᵀ d)ᵀ = dᵀ R``)."""
+    return (vertices - positions[:, None, :]) @ rotations
+
+
 def _in_frames(vertices: np.ndarray, pos: np.ndarray, rot: np.ndarray, best: np.ndarray, rows=None) -> np.ndarray:
     """``(T, m, 3)``: the vertices ``rows`` (all by default) in their frames ``best[rows]`` at every tick, one
     matrix product per frame: a ``(T, n, 3, 3)`` stack of each vertex's rotation, gathered, cost 4.5 times
@@ -94,7 +100,7 @@ def _in_frames(vertices: np.ndarray, pos: np.ndarray, rot: np.ndarray, best: np.
     local = np.empty((vertices.shape[0], len(rows), 3))
     for f in np.unique(frames):
         mine = np.flatnonzero(frames == f)
-        local[:, mine] = (vertices[:, rows[mine]] - pos[:, f, None, :]) @ rot[:, f]
+        local[:, mine] = in_frame(vertices[:, rows[mine]], pos[:, f], rot[:, f])
     return local
 
 
@@ -115,7 +121,7 @@ def _spreads(vertices, positions, rotations, candidates, probes):
     out = np.empty(candidates.shape)
     for f in np.unique(candidates):
         rows, cols = np.nonzero(candidates == f)
-        local = (v[:, rows] - p[:, f, None, :]) @ r[:, f]
+        local = in_frame(v[:, rows], p[:, f], r[:, f])
         out[rows, cols] = np.max(_lengths(local - local[:1]), axis=0)
     return out
 

@@ -239,7 +239,7 @@ class _Judgement:
         for f in np.flatnonzero(near.any(axis=0)):
             rows = np.flatnonzero(near[:, f])
             for k, (positions, rotations) in enumerate(self._variants, start=1):
-                local = (vertices[:, rows] - positions[:, f, None]) @ rotations[:, f]
+                local = attach_mod.in_frame(vertices[:, rows], positions[:, f], rotations[:, f])
                 error = attach_mod._errors(local).max(axis=1) / allowance[rows]
                 better = (error <= 1.0) & (error < score[rows])
                 frames[rows[better]], mistakes[rows[better]], score[rows[better]] = f, k, error[better]
@@ -269,7 +269,7 @@ class _Judgement:
         """Error ``(m, T)`` and allowance ``(m,)`` of vertices ``(T, m, 3)`` held by ``frame``."""
         pos, rot = self._with_world
         index = frame if frame >= 0 else pos.shape[1] - 1
-        error = attach_mod._errors((vertices - pos[:, index, None]) @ rot[:, index])
+        error = attach_mod._errors(attach_mod.in_frame(vertices, pos[:, index], rot[:, index]))
         return error, attach_mod._allowance(vertices, pos, rot, np.full(vertices.shape[1], index), self.tolerance)
 
     def _diagnose(self, vertices, frame, reference, allowance, bad_ticks) -> str:
@@ -293,8 +293,8 @@ class _Judgement:
         ticks = len(vertices)
         if ticks < 3:
             return False
-        now = (vertices - self.pos[:, f, None]) @ self.rot[:, f]
-        before = (vertices - self.r.before_positions[1:][:, f, None]) @ _rotations(self.r.before_orientations[1:][:, f])
+        now = attach_mod.in_frame(vertices, self.pos[:, f], self.rot[:, f])
+        before = attach_mod.in_frame(vertices, self.r.before_positions[1:][:, f], _rotations(self.r.before_orientations[1:][:, f]))
         for first in range(min(3, ticks)):
             right = np.all(np.linalg.norm(now - now[first], axis=-1) <= allowance, axis=1)
             late = np.all(np.linalg.norm(before - now[first], axis=-1) <= allowance, axis=1)
