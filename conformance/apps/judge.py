@@ -26,7 +26,7 @@ from scipy.spatial.transform import Rotation
 
 from conformance.apps import attachment as attach_mod, soft_bodies, welds
 from conformance.apps.verdict import DIAGNOSES, Verdict
-from conformance.apps.placement import bounding_radius, bounding_sphere, distance_to_shapes, place
+from conformance.apps.placement import bounding_radius, bounding_sphere, place, shape_distance
 from conformance.apps.recording import Recording, vertex_ranges
 from conformance.judge.tolerances import DEFAULT, Tolerance
 
@@ -49,6 +49,7 @@ class _Judgement:
         self.orn = recording.orientations[1:]
         self.rot = _rotations(self.orn) if self.orn.size else np.zeros(self.orn.shape[:-1] + (3, 3))
         self.event_ticks = sorted({int(e["frame"]) - 1 for e in recording.events})
+        self._distances: dict = {}  # frame -> its shape_distance, hulls computed once
         spheres = [bounding_sphere(f.shapes, f.mesh) for f in recording.frames]
         centres = np.array([c for c, _ in spheres]).reshape(-1, 3)
         radii = np.array([r for _, r in spheres])
@@ -72,7 +73,9 @@ class _Judgement:
         info = self.r.frames[frame]
         if info.node >= 0:  # a soft body's node is a point: a vertex drawn on it lies at its origin
             return np.linalg.norm(np.asarray(points, dtype=np.float64), axis=-1)
-        return distance_to_shapes(points, info.shapes, info.mesh, info.visuals)
+        if frame not in self._distances:
+            self._distances[frame] = shape_distance(info.shapes, info.mesh, info.visuals)
+        return self._distances[frame](points)
 
     def _apply_mapping(self, entry: dict) -> None:
         """Judge the mapped vertices in the frame the mapping names, not the one that holds them best:

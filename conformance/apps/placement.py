@@ -26,7 +26,7 @@ from scipy.spatial.transform import Rotation
 
 from conformance.judge.tolerances import DEFAULT, Tolerance
 
-__all__ = ["Placement", "bounding_radius", "bounding_sphere", "candidates", "distance_to_shapes", "place", "shape_box"]
+__all__ = ["Placement", "bounding_radius", "bounding_sphere", "candidates", "place", "shape_box", "shape_distance"]
 
 #: A drawing of another size than the collision shape is not judged, unless a vertex it holds lies further
 #: from the shape's centre than REACH times the shape's radius plus REACH_MARGIN: no decoration of a body
@@ -79,49 +79,62 @@ def bounding_sphere(shapes, mesh=()) -> tuple[np.ndarray, float]:
     return box[0], float(np.linalg.norm(box[1]))
 
 
-def distance_to_shapes(points: np.ndarray, shapes, mesh=(), visuals=()) -> np.ndarray:
-    """How far each of ``points`` ``(m, 3)`` (link-frame coordinates) lies outside a frame's collision
-    shapes, 0 on or inside one: boxes, spheres, cylinders and capsules exactly, mesh shapes by the convex
-    hull of ``mesh`` (pyBullet collides a mesh as its hull unless told otherwise); and outside each of its
-    ``visuals`` (:attr:`~conformance.apps.bodies.Frame.visuals`, by the hull of their points); inf for a
-    frame with none of them (a plane, say)."""
-    points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-    best = np.full(len(points), np.inf)
-    for visual in visuals:
-        best = np.minimum(best, _outside_hull(points, _framed(visual)))
+def shape_distance(shapes, mesh=(), visuals=()):
+    """A function telling how far each of its ``points`` ``(m, 3)`` (link-frame coordinates) lies outside
+    a frame's collision shapes, 0 on or inside one: boxes, spheres, cylinders and capsules exactly, mesh
+    shapes by the convex hull of ``mesh`` (pyBullet collides a mesh as its hull unless told otherwise); and
+    outside each of its ``visuals`` (:attr:`~conformance.apps.bodies.Frame.visuals`, by the hull of their
+    points); inf for a frame with none of them (a plane, say). The hulls are computed here, once: the app
+    judge asks about one frame for many sets of vertices, and a mesh's hull was most of what that cost."""
+    hulls = [_hull(_framed(visual)) for visual in visuals]
+    solids = []
     for kind, dims, position, orientation in shapes:
-        local = (points - np.asarray(position)) @ Rotation.from_quat(orientation).as_matrix()
-        if kind == "box":
-            outside = np.maximum(np.abs(local) - np.asarray(dims[:3]) / 2, 0.0)
-            distance = np.linalg.norm(outside, axis=1)
-        elif kind == "sphere":
-            distance = np.maximum(np.linalg.norm(local, axis=1) - dims[0], 0.0)
-        elif kind in ("cylinder", "capsule"):
-            height, radius = dims[0], dims[1]
-            radial = np.linalg.norm(local[:, :2], axis=1)
-            if kind == "cylinder":
-                distance = np.hypot(np.maximum(radial - radius, 0.0), np.maximum(np.abs(local[:, 2]) - height / 2, 0.0))
-            else:  # a segment of half length height/2 along z, swept by the radius
-                along = np.clip(local[:, 2], -height / 2, height / 2)
-                distance = np.maximum(np.hypot(radial, local[:, 2] - along) - radius, 0.0)
+        if kind in ("box", "sphere", "cylinder", "capsule"):
+            solids.append((kind, dims, np.asarray(position), Rotation.from_quat(orientation).as_matrix()))
         elif kind == "mesh" and len(mesh) >= 4:
-            distance = _outside_hull(points, np.asarray(mesh, dtype=np.float64))
-        else:
-            continue
-        best = np.minimum(best, distance)
-    return best
+            solids.append((kind, _hull(np.asarray(mesh, dtype=np.float64)), None, None))
+
+    def distance(points: np.ndarray) -> np.ndarray:
+        points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        best = np.full(len(points), np.inf)
+        for hull in hulls:
+            best = np.minimum(best, hull(points))
+        for kind, dims, position, matrix in solids:
+            if kind == "mesh":
+                best = np.minimum(best, dims(points))
+                continue
+            local = (points - position) @ matrix
+            if kind == "box":
+                outside = np.maximum(np.abs(local) - np.asarray(dims[:3]) / 2, 0.0)
+                found = np.linalg.norm(outside, axis=1)
+            elif kind == "sphere":
+                found = np.maximum(np.linalg.norm(local, axis=1) - dims[0], 0.0)
+            else:
+                height, radius = dims[0], dims[1]
+                radial = np.linalg.norm(local[:, :2], axis=1)
+                if kind == "cylinder":
+                    found = np.hypot(np.maximum(radial - radius, 0.0), np.maximum(np.abs(local[:, 2]) - height / 2, 0.0))
+                else:  # a segment of half length height/2 along z, swept by the radius
+                    along = np.clip(local[:, 2], -height / 2, height / 2)
+                    found = np.maximum(np.hypot(radial, local[:, 2] - along) - radius, 0.0)
+            best = np.minimum(best, found)
+        return best
+
+    return distance
 
 
-def _outside_hull(points: np.ndarray, vertices: np.ndarray) -> np.ndarray:
-    """How far ``points`` lie outside the convex hull of ``vertices`` (the largest plane distance, 0 inside)."""
+def _hull(vertices: np.ndarray):
+    """How far points lie outside the convex hull of ``vertices`` (the largest plane distance, 0 inside),
+    as a function of the points; a flat or degenerate hull by its bounding box."""
     from scipy.spatial import ConvexHull, QhullError
 
     try:
         planes = ConvexHull(vertices).equations
-    except (QhullError, ValueError):  # flat or degenerate: its bounding box
+    except (QhullError, ValueError):
         low, high = vertices.min(axis=0), vertices.max(axis=0)
-        return np.linalg.norm(np.maximum(np.maximum(low - points, points - high), 0.0), axis=1)
-    return np.maximum((points @ planes[:, :3].T + planes[:, 3]).max(axis=1), 0.0)
+        return lambda points: np.linalg.norm(np.maximum(np.maximum(low - points, points - high), 0.0), axis=1)
+    normals, offsets = planes[:, :3].T, planes[:, 3]
+    return lambda points: np.maximum((points @ normals + offsets).max(axis=1), 0.0)
 
 
 @dataclass
