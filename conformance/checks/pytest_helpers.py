@@ -204,10 +204,10 @@ class Kit:
         yield
         profiles.aim(self.closest, label)
 
-    def _record(self, results: Sequence[Any]) -> None:
-        if not results:
+    def _record(self, worst: Any) -> None:
+        """Note ``worst`` (a frame's worst vertex record, in tolerances; None: no target) as the figure."""
+        if worst is None:
             return
-        worst = max(results, key=_by_ratio)
         ratio = worst.error / worst.tolerance if worst.tolerance else worst.error
         figures.note("vertex position", worst.error, worst.tolerance, where=f"{worst.target!r} frame {worst.frame}")
         if not self.closest >= ratio:  # NaN wins
@@ -225,11 +225,11 @@ class Kit:
         __tracebackhide__ = True
         frames = compare.link_poses(run.drawing)  # read once for vertices and normals alike
         results = compare.compare_vertices(run.drawing, run.frame, self.tolerance, frames=frames)
-        self._record(results)
+        self._record(results.worst())
         sync = self.sync
         # Vertices (with assert_vertices_match's message), then normals, then announcements: default mode
         # raises the first of them, survey mode notes each.
-        failures = [r for r in results if not r.ok]
+        failures = results.failures()
         if failures:
             worst = max(failures, key=_by_ratio)
             # What the failing targets are drawn as, read only if a message or picture is made (a survey

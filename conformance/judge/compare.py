@@ -6,6 +6,7 @@ The pytest checks turn records into pass/fail; the command line and reports prin
 from __future__ import annotations
 
 import weakref
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -20,6 +21,7 @@ __all__ = [
     "GeometryResult",
     "NormalResult",
     "VertexResult",
+    "VertexResults",
     "compare_bounds",
     "compare_collision_geometry",
     "compare_normals",
@@ -117,11 +119,49 @@ def link_poses(drawing: Drawing) -> tuple[np.ndarray, np.ndarray]:
     return positions, poses.matrices(orientations)
 
 
+class VertexResults(Sequence):
+    """:func:`compare_vertices`' records, one :class:`VertexResult` per target, kept as arrays and made
+    into records only when read: a frame's check reads the worst and the failures (:meth:`worst`,
+    :meth:`failures`), and making a record of each of a brick wall's hundred targets was most of a
+    frame's comparison."""
+
+    def __init__(self, drawing: Drawing, frame: int, error, tolerance, vertex, expected, actual):
+        self._drawing, self._frame = drawing, frame
+        self.error, self.tolerance, self._vertex, self._expected, self._actual = error, tolerance, vertex, expected, actual
+
+    def __len__(self) -> int:
+        return len(self.error)
+
+    def __getitem__(self, i):
+        if isinstance(i, slice):
+            return [self[k] for k in range(*i.indices(len(self)))]
+        i = range(len(self))[i]
+        t = self._drawing.targets[i]
+        return VertexResult(scene=self._drawing.world.scene, target=t.name, body=t.body, link=t.link, frame=self._frame,
+                            error=float(self.error[i]), tolerance=float(self.tolerance[i]), vertex=int(self._vertex[i]),
+                            expected=tuple(map(float, self._expected[i])), actual=tuple(map(float, self._actual[i])))
+
+    def worst(self) -> VertexResult | None:
+        """The largest error in tolerances, a NaN error first (the first of equals, as ``max`` picks)."""
+        if not len(self):
+            return None
+        nan = np.isnan(self.error)
+        if nan.any():
+            return self[int(np.argmax(nan))]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = np.where(self.tolerance != 0, self.error / np.where(self.tolerance != 0, self.tolerance, 1.0), self.error)
+        return self[int(np.argmax(ratio))]
+
+    def failures(self) -> list[VertexResult]:
+        """The records of the targets drawn outside their tolerance (or at NaN), in target order."""
+        return [self[int(i)] for i in np.flatnonzero(~(self.error <= self.tolerance))]
+
+
 def compare_vertices(drawing: Drawing, frame: int, tolerance: Tolerance = DEFAULT, *,
-                     frames: tuple[np.ndarray, np.ndarray] | None = None) -> list[VertexResult]:
+                     frames: tuple[np.ndarray, np.ndarray] | None = None) -> VertexResults:
     """One record per target: the worst vertex of what the renderer draws vs pybullet's pose
     (``frames``: :func:`link_poses` read at this frame, else read here)."""
-    targets = drawing.targets
+    n = len(drawing.targets)
     positions, rotations = frames if frames is not None else link_poses(drawing)
     layout = _layout(drawing)
     drawn = {}
@@ -131,24 +171,21 @@ def compare_vertices(drawing: Drawing, frame: int, tolerance: Tolerance = DEFAUL
             drawn[id(actor)] = backends.world_vertices(actor)
         return drawn[id(actor)]
 
-    tolerances = tolerance.for_extents(layout.extents, positions)
-    results: list[VertexResult | None] = [None] * len(targets)
+    error, vertex = np.zeros(n), np.zeros(n, dtype=int)
+    expected_at, actual_at = np.zeros((n, 3)), np.zeros((n, 3))
     for rows, local in layout.groups:
+        if not local.shape[1]:  # targets without vertices: error 0 at vertex 0, drawn and expected at the origin
+            continue
         actual = _gather(drawing, rows, read)
         expected = np.einsum("nij,nkj->nki", rotations[rows], local) + positions[rows][:, None, :]
         errors = np.linalg.norm(actual - expected, axis=2)
         errors = np.where(np.isfinite(errors), errors, np.inf)
-        worst = np.argmax(errors, axis=1) if errors.shape[1] else np.zeros(len(rows), dtype=int)
-        for k, i in enumerate(rows):
-            t, w = targets[i], int(worst[k])
-            empty = not errors.shape[1]
-            results[i] = VertexResult(
-                scene=drawing.world.scene, target=t.name, body=t.body, link=t.link, frame=frame,
-                error=0.0 if empty else float(errors[k, w]), tolerance=float(tolerances[i]), vertex=w,
-                expected=(0.0, 0.0, 0.0) if empty else tuple(map(float, expected[k, w])),
-                actual=(0.0, 0.0, 0.0) if empty else tuple(map(float, actual[k, w])),
-            )
-    return results
+        worst = np.argmax(errors, axis=1)
+        k = np.arange(len(rows))
+        error[rows], vertex[rows] = errors[k, worst], worst
+        expected_at[rows], actual_at[rows] = expected[k, worst], actual[k, worst]
+    return VertexResults(drawing, frame, error, tolerance.for_extents(layout.extents, positions), vertex,
+                         expected_at, actual_at)
 
 
 @dataclass(frozen=True)
