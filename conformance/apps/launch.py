@@ -1,18 +1,25 @@
 """Running an app in a process of its own and reading back what it recorded.
 
-The app runs as ``python -m conformance.apps.child`` (:mod:`conformance.apps.child`) with this
-interpreter, so its globals, the kit's patches, and whatever the app does to the process (exit, crash,
-hang) stay there. ``timeout`` bounds the whole run; an app that exceeds it, crashes or refuses to hand
-over its loop gives :class:`AppFailed` with one paragraph saying which.
+The app runs in a process of its own (:mod:`conformance.apps.child`), so its globals, the kit's patches,
+and whatever the app does to the process (exit, crash, hang) stay there. That process is forked from a
+server that has imported FURY once (:mod:`multiprocessing`'s ``forkserver``, preloading
+:mod:`conformance.apps.preload`), not started afresh: importing FURY was most of a short run. It has this
+process's environment, working directory and ``sys.path``, and runs ``atexit`` handlers as a Python
+process does at exit. Where there is no ``forkserver`` (Windows) it is ``python -m conformance.apps.child``.
+``timeout`` bounds the whole run; an app that exceeds it, crashes or refuses to hand over its loop gives
+:class:`AppFailed` with one paragraph saying which.
 """
 
 from __future__ import annotations
 
 import json
+import multiprocessing
 import os
 import subprocess
 import sys
 import tempfile
+import threading
+import types
 from pathlib import Path
 
 from conformance.apps import recording as recording_mod
@@ -42,15 +49,13 @@ def record(script: str | os.PathLike, *, ticks: int = 120, events=(), tick_funct
         raise AppFailed(f"app={str(script)!r}: no such file; give the path of the Python script that runs your simulation")
     with tempfile.TemporaryDirectory(prefix="conformance-app-") as work:
         out = Path(work) / "recording.npz"
-        command = [sys.executable, "-m", "conformance.apps.child", str(script), "--out", str(out),
-                   "--ticks", str(int(ticks)), "--events", json.dumps(list(events))]
+        argv = [str(script), "--out", str(out), "--ticks", str(int(ticks)), "--events", json.dumps(list(events))]
         if tick_function:
-            command += ["--tick", tick_function]
+            argv += ["--tick", tick_function]
         env = dict(os.environ)
         env.setdefault("PYTHONFAULTHANDLER", "1")
         try:
-            done = subprocess.run(command, capture_output=True, text=True, timeout=timeout, env=env,
-                                  stdin=subprocess.DEVNULL)
+            returncode, stderr = _run_child(argv, env, timeout, Path(work) / "stderr.txt")
         except subprocess.TimeoutExpired as exc:
             raise AppFailed(f"{script}: the app did not finish {ticks} ticks within {timeout:g} s and was stopped "
                             f"(a callback that never returns, or a loop of its own the kit did not take over). "
@@ -63,15 +68,134 @@ def record(script: str | os.PathLike, *, ticks: int = 120, events=(), tick_funct
         error = Path(str(out) + ".error")
         if error.exists():
             raise AppFailed(error.read_text(encoding="utf-8").strip())
-        if done.returncode != 0 or not out.exists():
-            how = f"was killed by signal {-done.returncode}" if done.returncode < 0 else f"exited with status {done.returncode}"
+        if returncode != 0 or not out.exists():
+            how = f"was killed by signal {-returncode}" if returncode < 0 else f"exited with status {returncode}"
             raise AppFailed(f"{script}: the app's process {how} before the kit had its recording (the process crashed). "
-                            f"Its last output: {_tail(done.stderr)}")
+                            f"Its last output: {_tail(stderr)}")
         return recording_mod.load(out)
 
 
+_server_lock = threading.Lock()
+_start_lock = threading.Lock()
+_server = None
+
+
+def _forkserver():
+    """The forkserver context whose server has imported :mod:`conformance.apps.preload` (None where there is none)."""
+    global _server
+    with _server_lock:
+        if _server is None and "forkserver" in multiprocessing.get_all_start_methods():
+            _server = multiprocessing.get_context("forkserver")
+            _server.set_forkserver_preload(["conformance.apps.preload"])
+            _start_quietly()
+        return _server
+
+
+def _start_quietly() -> None:
+    """Start the server with its stderr nowhere: importing pyBullet prints its "build time" there, a
+    second copy of this process's own line in the kit's output. Every app process sets its own."""
+    from multiprocessing import forkserver
+
+    saved, quiet = os.dup(2), os.open(os.devnull, os.O_WRONLY)
+    sys.stderr.flush()
+    os.dup2(quiet, 2)
+    try:
+        forkserver.ensure_running()
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
+        os.close(quiet)
+
+
+def _run_child(argv: list[str], env: dict, timeout: float, stderr_path: Path) -> tuple[int, str]:
+    """Run :func:`conformance.apps.child.main` on ``argv`` in a process of its own with ``env``; its exit
+    status (negative: the signal that killed it) and what it wrote to stderr. Raises
+    :class:`subprocess.TimeoutExpired` (with that stderr) when it runs past ``timeout``; it is killed then."""
+    server = _forkserver()
+    if server is None:
+        command = [sys.executable, "-m", "conformance.apps.child", *argv]
+        done = subprocess.run(command, capture_output=True, text=True, timeout=timeout, env=env, stdin=subprocess.DEVNULL)
+        return done.returncode, done.stderr
+    process = server.Process(target=_child_main, args=(argv, env, str(stderr_path)), daemon=False)
+    _start(process)
+    try:
+        process.join(timeout)
+        if process.exitcode is None:
+            process.kill()
+            process.join()
+            raise subprocess.TimeoutExpired(argv, timeout, stderr=_read(stderr_path))
+    finally:
+        if process.exitcode is None:  # interrupted (Ctrl-C): the app's process does not outlive the kit's
+            process.kill()
+            process.join()
+    return process.exitcode, _read(stderr_path)
+
+
+def _start(process) -> None:
+    """Start ``process`` with no main module for multiprocessing to import in it: it would run this
+    program's script again there as ``__mp_main__``, and a script that calls :func:`record` at its top level
+    (no ``if __name__ == "__main__":``) would call it again and die, silently. Nothing of ``__main__`` is sent."""
+    with _start_lock:  # one swap at a time: two interleaved would leave the stand-in in place
+        main = sys.modules["__main__"]
+        sys.modules["__main__"] = types.ModuleType("__main__")
+        try:
+            process.start()
+        finally:
+            sys.modules["__main__"] = main
+
+
+def _read(path: Path) -> str:
+    try:
+        return path.read_text(encoding="utf-8", errors="replace")
+    except FileNotFoundError:
+        return ""
+
+
+def _child_main(argv: list[str], env: dict, stderr_path: str) -> None:
+    """In the forked process: what ``python -m conformance.apps.child ARGV`` would do, with its output
+    where :func:`_run_child` reads it (stdout nowhere, as before: only stderr is ever shown)."""
+    import atexit
+    import faulthandler
+
+    from conformance.apps import child
+
+    quiet = os.open(os.devnull, os.O_RDWR)
+    os.dup2(quiet, 0)
+    os.dup2(quiet, 1)
+    os.dup2(os.open(stderr_path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600), 2)
+    os.environ.clear()
+    os.environ.update(env)
+    faulthandler.enable()
+    try:
+        code = child.main(argv)
+    finally:
+        atexit._run_exitfuncs()  # a process of multiprocessing's ends in os._exit: the app's handlers, the Xvfb it started
+        sys.stdout.flush()
+        sys.stderr.flush()
+    sys.exit(code)
+
+
+#: where the frames of a crash's dump are the kit's or Python's own, around the app's: left out of its last words
+_OWN_FRAMES = (str(Path(__file__).resolve().parent.parent), str(Path(multiprocessing.__file__).resolve().parent),
+               '"<frozen ', '"<string>"')
+
+
 def _tail(text, lines: int = 12) -> str:
+    """The last ``lines`` of the app's output. A crash's dump (faulthandler's) is cut to its error and the
+    crashing thread's frames that are not the kit's or Python's (the app's, its libraries'): the frames the
+    kit runs the app in, the other threads' stacks and the list of extension modules do not say where the
+    app was."""
     if isinstance(text, bytes):
         text = text.decode("utf-8", "replace")
-    kept = [line for line in (text or "").strip().splitlines() if "pybullet build time" not in line]
-    return "\n".join(kept[-lines:]) or "(nothing)"
+    kept = [line for line in (text or "").strip().splitlines()
+            if "pybullet build time" not in line and not (line.lstrip().startswith('File "') and any(own in line for own in _OWN_FRAMES))]
+    fatal = next((i for i, line in enumerate(kept) if line.startswith("Fatal Python error:")), None)
+    if fatal is not None:
+        dump, crashing = [kept[fatal]], False
+        for line in kept[fatal + 1:]:
+            if line.startswith(("Thread 0x", "Current thread", "Extension modules:")):
+                crashing = line.startswith("Current thread")
+            if crashing and line.strip():
+                dump.append(line)
+        kept = kept[:fatal][-2:] + dump
+    return "\n".join(kept[-lines:]).strip() or "(nothing)"
