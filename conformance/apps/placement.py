@@ -227,7 +227,11 @@ def place(reference: np.ndarray, shapes, inertial_position, *, tolerance: Tolera
         if not np.all(np.abs(drawn_half - half) <= room):
             continue
         offset = drawn_centre - centre
-        if np.all(np.abs(offset) <= room):
+        # A drawing smaller than its shape along an axis may sit anywhere inside it there: the vertices a
+        # frame holds may be part of what is drawn for it, the rest held by frames they equally lie on
+        # (a wall's inner corners, on the floor and the next wall too, in a pit that never moves).
+        slack = room + np.maximum(half - drawn_half, 0.0)
+        if np.all(np.abs(offset) <= slack):
             return Placement(True, True, f"on {what}", shape=which)
         inertial = np.asarray(inertial_position, dtype=np.float64)
         diagnosis = ""
@@ -239,9 +243,10 @@ def place(reference: np.ndarray, shapes, inertial_position, *, tolerance: Tolera
         for mistake, m_centre, m_half in _mistakes(visuals):
             if not diagnosis and np.all(np.abs(m_half - drawn_half) <= room) and np.all(np.abs(m_centre - drawn_centre) <= room):
                 diagnosis = mistake
+        axis = int(np.argmax(np.abs(offset) - slack))
         return Placement(True, False, f"drawn {np.linalg.norm(offset):.4g} m off {what} (drawn centre "
-                         f"{_v(drawn_centre)} in the link frame, the shape's {_v(centre)}; allowed {room:.3g} m)",
-                         offset, diagnosis, which)
+                         f"{_v(drawn_centre)} in the link frame, the shape's {_v(centre)}; allowed {slack[axis]:.3g} m "
+                         f"along {'xyz'[axis]})", offset, diagnosis, which)
     for mistake, m_centre, m_half in _mistakes(visuals):
         room = allowance(m_half)
         if np.all(np.abs(m_half - drawn_half) <= room) and np.all(np.abs(m_centre - drawn_centre) <= room):
