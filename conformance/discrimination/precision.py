@@ -241,7 +241,8 @@ def app_draws(paths, seeds, *, runs: int, jobs: int | None = None, timeout: floa
         draw.seconds = time.monotonic() - start
         return draw
 
-    todo = [(("app", str(path), seed, runs), (path, seed)) for path in paths for seed in seeds]
+    # seed by seed, every app in each: a long run stopped part-way has made draws of every app
+    todo = [(("app", str(path), seed, runs), (path, seed)) for seed in seeds for path in paths]
     return _run_all(todo, one, journal, jobs, "app draws made")
 
 
