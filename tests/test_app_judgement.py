@@ -125,9 +125,10 @@ def test_a_shape_or_part_of_it_drawn_off_it_is_still_placed_wrong(drawn, allowed
         points = WALL_CORNERS + (np.array([0.06, 0.0, 0.0]) if "x" in drawn else np.array([0.0, 0.06, 0.0]))
     else:
         points = WALL_CORNERS[WALL_CORNERS[:, 1] < 0] - [0.0, 0.06, 0.0]
-    found = placement.place(points, WALL, (0.0, 0.0, 0.0))
+    found = placement.place(points + 1e-9, WALL, (0.0, 0.0, 0.0))  # float32's rounding of a drawing 1 m out
     assert found.judged and not found.ok, found.why
     assert f"allowed {allowed})" in found.why, found.why
+    assert "e-0" not in found.why and "e-1" not in found.why, f"the rounding of a 0 printed: {found.why}"
 
 
 @pytest.mark.parametrize("shared", [True, False])

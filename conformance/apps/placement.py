@@ -274,4 +274,6 @@ _MISTAKEN = {"visual-frame": "without its visual frame (getVisualShapeData(...)[
 
 
 def _v(values) -> str:
-    return "(" + ", ".join(f"{v:.4g}" for v in values) + ")"
+    """Coordinates in metres to 4 digits; under 0.1 µm, the rounding of a centre that is 0 (-5.551e-17 said
+    nothing a reader could use), as 0."""
+    return "(" + ", ".join(f"{v:.4g}" if abs(v) >= 1e-7 else "0" for v in values) + ")"
