@@ -67,6 +67,29 @@ def _apply(due, client: int, frames: list[Frame]) -> None:
         scene = _scene(client, frames, dynamic=not isinstance(event, scene_events.JointReset))
         if scene.bindings:
             event.apply(scene)
+            if not isinstance(event, scene_events.Kick):
+                _clear_of_static(scene.p, client, frames)
+
+
+#: how deep in a static body a body may be left by the kit's teleport or joint reset (m)
+DEPTH = 1e-3
+
+
+def _clear_of_static(p, client: int, frames: list[Frame]) -> None:
+    """Lift each dynamic body out of the static bodies the kit's own teleport or joint reset put it in, along
+    the contact normal: a robot pushed into the ground plane has a part below it, which pyBullet's renderer
+    hides behind the plane and an app that does not draw the plane shows, so the pictures disagree about a
+    pose no story of the app's produces (measured: R2-D2 rejected by ``pictured`` in most draws of 20
+    perturbed runs). The sync still meets the turned pose; it only lands on the ground, not in it."""
+    statics = sorted({f.body for f in frames if f.client == client and f.link == -1 and f.node < 0 and f.mass == 0})
+    movers = sorted({f.body for f in frames if f.client == client and f.link == -1 and f.node < 0 and f.mass > 0})
+    for body in movers:
+        for _ in range(4):
+            deepest = min((c for s in statics for c in p.getClosestPoints(body, s, 0.0)), key=lambda c: c[8], default=None)
+            if deepest is None or deepest[8] >= -DEPTH:
+                break
+            pos, orn = p.getBasePositionAndOrientation(body)
+            p.resetBasePositionAndOrientation(body, [a - deepest[8] * n for a, n in zip(pos, deepest[7])], orn)
 
 
 def as_dict(event) -> dict:
