@@ -120,14 +120,13 @@ def _run_child(argv: list[str], env: dict, timeout: float, stderr_path: Path) ->
     _start(process)
     try:
         process.join(timeout)
-        if process.exitcode is None:
-            process.kill()
-            process.join()
-            raise subprocess.TimeoutExpired(argv, timeout, stderr=_read(stderr_path))
+        timed_out = process.exitcode is None
     finally:
-        if process.exitcode is None:  # interrupted (Ctrl-C): the app's process does not outlive the kit's
+        if process.exitcode is None:  # past the timeout, or interrupted (Ctrl-C): it does not outlive the kit's
             process.kill()
             process.join()
+    if timed_out:
+        raise subprocess.TimeoutExpired(argv, timeout, stderr=_read(stderr_path))
     return process.exitcode, _read(stderr_path)
 
 
