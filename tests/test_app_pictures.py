@@ -297,3 +297,29 @@ def test_only_the_picture_check_sees_the_example_mistake(ticks, tmp_path):
     written = pictured.keep(verdict, tmp_path, result.reproduce())
     assert {Path(w).name.rsplit("-", 1)[-1] for w in written} == {"fury_mask.png", "pybullet_mask.png", "mask_difference.png"}
     assert all((tmp_path / w).stat().st_size for w in written)
+
+
+def test_a_face_stands_for_the_frame_that_alone_holds_one_of_its_corners():
+    """A face whose first corner two frames hold equally (a chain disc's cap centre lies on the spherical
+    joint, fixed in both links) is its next corner's frame's: labelled by its first corner, FURY 0.12's
+    chain example had a disc's whole cap shown as its neighbour, in front of two discs (IoU 0.367)."""
+    from conformance.apps import pictured
+    from conformance.apps.attachment import Attachment
+
+    pos, orn = motion()
+    r = recording([box_frame(), box_frame(1)], [(pos, orn), (pos + [0.5, 0, 0], orn)], [track(draw(pos, orn))])
+    # vertex 0: on the joint, tied, given to frame 0; vertices 1-3: frame 1's alone
+    held = Attachment(frame=np.array([0, 1, 1, 1]), error=np.zeros((4, 1)), allowance=np.ones(4),
+                      reference=np.zeros((4, 3)), tied=np.array([True, False, False, False]))
+    faces = np.where(_square(), 0, -1)  # face 0 of the actor (corners 0, 1, 2) fills the square
+    shot = {"faces": faces.astype(np.int32), "corners": np.array([[0, 1, 2]]), "bullet": faces.astype(np.int32),
+            "faint": np.zeros(4, bool)}
+    fury, bullet = pictured.labels(shot, r, [held], judged={0, 1}, background=set())
+    assert set(np.unique(fury[_square()])) == {1}, "the face should be frame 1's, whose corners 1 and 2 only it holds"
+    shot["bullet"] = np.where(_square(), 1, -1).astype(np.int32)
+    fury, bullet = pictured.labels(shot, r, [held], judged={0, 1}, background=set())
+    assert np.array_equal(fury, bullet)
+    # with every corner tied, the first stands for the face, as before
+    held.tied[:] = True
+    fury, _ = pictured.labels(shot, r, [held], judged={0, 1}, background=set())
+    assert set(np.unique(fury[_square()])) == {0}

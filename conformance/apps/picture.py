@@ -8,9 +8,10 @@ renderer draws its segmentation mask on each of the app's clients from the same 
 its depth buffer
 (:func:`conformance.rendering.silhouettes.pybullet_mask`, the scene checks' own). Which body a face
 draws is not known here: the judgement (:mod:`conformance.apps.pictured`) labels each face by the frame
-the attachment gives its first vertex. So the picture keeps, per pixel, the app-wide index of that
-vertex (actors in the recording's order, -1 for the background, -2 for a pixel whose colour is no code:
-a shader or texture the kit could not switch off).
+the attachment gives the first of its corners one frame alone holds. So the picture keeps, per pixel,
+the index of the face seen (-1 for the background, -2 for a pixel whose colour is no code: a shader or
+texture the kit could not switch off), and each face's first :data:`CORNERS` app-wide vertices (actors
+in the recording's order).
 
 What the picture shows that the recorded vertices do not: an actor hidden (``SetVisibility(0)``,
 ``visible = False``) or so transparent it changes no pixel by more than the golden check's 32 levels
@@ -120,7 +121,8 @@ def touching(client: int, frames) -> list[list[int]]:
 
 def take(source, tracks, frames, clients, tick: int) -> dict:
     """The pictures of the app's scene now (after tick ``tick``), as a dict the recording keeps: ``tick``,
-    ``size``, ``camera``, ``vertices`` (h, w) app-wide vertex index per pixel, ``bullet`` (h, w) frame index
+    ``size``, ``camera``, ``faces`` (h, w) face index per pixel and ``corners`` (each face's first
+    :data:`CORNERS` app-wide vertices: :func:`pixel_vertices`), ``bullet`` (h, w) frame index
     per pixel (-1 none), ``faint`` and ``stale`` (one bool per app-wide vertex: drawn fainter than
     :data:`FAINT`; held by the GPU elsewhere than its array), ``hidden`` (per actor), ``touching``,
     ``notes``; or only ``tick`` and ``skipped`` (why no picture was taken)."""
@@ -151,8 +153,8 @@ def take(source, tracks, frames, clients, tick: int) -> dict:
         bullet[front] = np.asarray(own + [-1], dtype=np.int32)[seen[front]]
         nearest[front] = depth[front]
         pairs += touching(client, frames)
-    return {"tick": tick, "size": list(size), "camera": camera.as_dict(), "vertices": drawn["vertices"],
-            "bullet": bullet, "faint": drawn["faint"], "stale": drawn["stale"], "hidden": drawn["hidden"],
+    return {"tick": tick, "size": list(size), "camera": camera.as_dict(), "faces": drawn["faces"],
+            "corners": drawn["corners"], "bullet": bullet, "faint": drawn["faint"], "stale": drawn["stale"], "hidden": drawn["hidden"],
             "touching": pairs, "notes": list(drawn.get("notes", []))}
 
 
@@ -163,19 +165,44 @@ def view_angle(vertical: float | None = None, *, horizontal: float | None = None
     return math.degrees(2 * math.atan(math.tan(math.radians(horizontal) / 2) / aspect))
 
 
-def face_codes(first_vertices: list[np.ndarray], vertex_offsets: list[int]) -> tuple[np.ndarray, np.ndarray]:
-    """Colours coding every face of every actor (:func:`conformance.backends.common.id_colors`), and
-    the app-wide vertex each code stands for (the face's first vertex)."""
+#: Corners of each face kept with a picture: a face is labelled by the first of them some frame alone holds
+#: (:func:`conformance.apps.pictured.labels`).
+CORNERS = 3
+
+
+def face_codes(corners: list[np.ndarray], vertex_offsets: list[int]) -> tuple[np.ndarray, np.ndarray]:
+    """Colours coding every face of every actor (:func:`conformance.backends.common.id_colors`), and the
+    app-wide vertices of each face's first :data:`CORNERS` corners (``(faces, CORNERS)``; a point or line
+    repeats its last), in code order."""
     from conformance.backends.common import id_colors
 
-    owners = np.concatenate([f + o for f, o in zip(first_vertices, vertex_offsets)]) if first_vertices else np.zeros(0, int)
+    rows = [np.asarray(c, dtype=np.int64).reshape(len(c), -1) + o for c, o in zip(corners, vertex_offsets)]
+    rows = [np.concatenate([r, np.repeat(r[:, -1:], max(CORNERS - r.shape[1], 0), axis=1)], axis=1)[:, :CORNERS]
+            for r in rows]
+    owners = np.concatenate(rows) if rows else np.zeros((0, CORNERS), np.int64)
     return id_colors(len(owners)), owners.astype(np.int64)
 
 
-def decode(picture: np.ndarray, owners: np.ndarray) -> np.ndarray:
-    """``(h, w)`` app-wide vertex index of the face seen at each pixel of a face-coded ``picture``."""
+def decode(picture: np.ndarray, count: int) -> np.ndarray:
+    """``(h, w)`` int32 index of the face seen at each pixel of a face-coded ``picture`` of ``count`` faces:
+    -1 for the background, -2 for a pixel that is no face's code colour."""
     from conformance.backends.common import decode_ids
 
-    faces = decode_ids(picture, len(owners), strict=False)
-    table = np.concatenate([owners, [-2, -1]]).astype(np.int32)  # faces[...] == -2 → -2, -1 → -1
-    return table[np.where(faces >= 0, faces, len(owners) + faces + 2)]
+    return decode_ids(picture, count, strict=False)
+
+
+def pixel_vertices(shot: dict, usable: np.ndarray | None = None) -> np.ndarray:
+    """``(h, w)`` the app-wide vertex that stands for the face seen at each pixel of ``shot`` (-1 background,
+    -2 no face's code colour): the face's first corner, or the first of its corners ``usable`` marks (a
+    mask over the app-wide vertices), where it has one. A picture recorded with a vertex per pixel
+    (``vertices``) is read as it is."""
+    if "faces" not in shot:
+        return np.asarray(shot["vertices"], dtype=np.int64)
+    corners = np.asarray(shot["corners"], dtype=np.int64).reshape(-1, CORNERS)
+    pick = np.zeros(len(corners), dtype=np.int64)
+    if usable is not None and len(corners):
+        ok = np.asarray(usable, dtype=bool)[corners]
+        pick = np.where(ok.any(axis=1), ok.argmax(axis=1), 0)
+    table = np.concatenate([corners[np.arange(len(corners)), pick], [-2, -1]])  # faces -2 → -2, -1 → -1
+    faces = np.asarray(shot["faces"], dtype=np.int64)
+    return table[np.where(faces >= 0, faces, len(corners) + faces + 2)]

@@ -97,7 +97,7 @@ def faces(showm, actors, cam, size, gpu) -> dict:
     offsets = np.concatenate([[0], np.cumsum(counts)]).astype(int)
     triangles = [np.asarray(a.geometry.indices.data) for a in actors]
     triangles = [t.reshape(len(t), -1) if t.ndim == 2 else t.reshape(-1, 3) for t in triangles]
-    colours, owners = picture.face_codes([t[:, 0].astype(np.int64) for t in triangles], list(offsets[:-1]))
+    colours, owners = picture.face_codes([t.astype(np.int64) for t in triangles], list(offsets[:-1]))
     scene = pygfx.Scene()
     scene.add(pygfx.Background.from_color((0.0, 0.0, 0.0, 1.0)))
     stale, start = [], 0
@@ -125,7 +125,7 @@ def faces(showm, actors, cam, size, gpu) -> dict:
     view = pygfx.PerspectiveCamera(50, 1)
     backend._set_camera(view, cam, size)
     pixels = backend._draw(scene, view, size, "none")
-    return {"vertices": picture.decode(pixels, owners),
+    return {"faces": picture.decode(pixels, len(owners)), "corners": owners,
             "faint": np.concatenate([_alpha(a) < picture.FAINT for a in actors]) if actors else np.zeros(0, bool),
             "stale": np.concatenate(stale) if stale else np.zeros(0, bool),
             "hidden": [not backend._visible(a) for a in actors], "notes": []}

@@ -41,18 +41,20 @@ def camera(showm):
     return picture.Camera(tuple(cam.GetPosition()), tuple(cam.GetFocalPoint()), tuple(cam.GetViewUp()), angle), size, ""
 
 
-def _first_vertices(data) -> np.ndarray:
-    """The first point of every cell, in VTK's cell order (verts, lines, polys, strips): what cell
-    scalars are indexed by."""
+def _corners(data) -> np.ndarray:
+    """The first :data:`~conformance.apps.picture.CORNERS` points of every cell (a cell with fewer repeats
+    its last), in VTK's cell order (verts, lines, polys, strips): what cell scalars are indexed by."""
     from vtkmodules.util import numpy_support
 
-    firsts = []
+    corners = []
     for cells in (data.GetVerts(), data.GetLines(), data.GetPolys(), data.GetStrips()):
         if cells is None or not cells.GetNumberOfCells():
             continue
-        offsets = numpy_support.vtk_to_numpy(cells.GetOffsetsArray())[:-1]
-        firsts.append(numpy_support.vtk_to_numpy(cells.GetConnectivityArray())[offsets])
-    return np.concatenate(firsts).astype(np.int64) if firsts else np.zeros(0, np.int64)
+        offsets = numpy_support.vtk_to_numpy(cells.GetOffsetsArray())
+        connectivity = numpy_support.vtk_to_numpy(cells.GetConnectivityArray())
+        starts, sizes = offsets[:-1], np.diff(offsets)
+        corners.append(np.stack([connectivity[starts + np.minimum(j, sizes - 1)] for j in range(picture.CORNERS)], axis=1))
+    return np.concatenate(corners).astype(np.int64) if corners else np.zeros((0, picture.CORNERS), np.int64)
 
 
 def _alpha(actor) -> np.ndarray:
@@ -78,8 +80,8 @@ def faces(showm, actors, cam, size, gpu=None) -> dict:
     datas = [a.GetMapper().GetInput() for a in actors]
     counts = [d.GetNumberOfPoints() for d in datas]
     offsets = np.concatenate([[0], np.cumsum(counts)]).astype(int)
-    firsts = [_first_vertices(d) for d in datas]
-    colours, owners = picture.face_codes(firsts, list(offsets[:-1]))
+    corners = [_corners(d) for d in datas]
+    colours, owners = picture.face_codes(corners, list(offsets[:-1]))
     faint = np.concatenate([_alpha(a) < picture.FAINT for a in actors]) if actors else np.zeros(0, bool)
     hidden = [not a.GetVisibility() for a in actors]
     undo = []
@@ -93,7 +95,7 @@ def faces(showm, actors, cam, size, gpu=None) -> dict:
                 prop.SetVisibility(0)
                 undo.append(lambda prop=prop: prop.SetVisibility(1))
         start = 0
-        for actor, data, first in zip(actors, datas, firsts):
+        for actor, data, first in zip(actors, datas, corners):
             mapper = actor.GetMapper()
             cells = data.GetCellData()
             active = cells.GetScalars()
@@ -171,5 +173,5 @@ def faces(showm, actors, cam, size, gpu=None) -> dict:
     notes = []
     if (width, height) != tuple(size):
         notes.append(f"the app's window drew {width}x{height} pixels where {size[0]}x{size[1]} were asked")
-    return {"vertices": picture.decode(np.ascontiguousarray(pixels), owners), "faint": faint,
+    return {"faces": picture.decode(np.ascontiguousarray(pixels), len(owners)), "corners": owners, "faint": faint,
             "stale": np.zeros(int(offsets[-1]), bool), "hidden": hidden, "notes": notes}
