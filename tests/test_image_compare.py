@@ -86,3 +86,41 @@ def test_tolerance_by_name_with_overrides_from_strings():
     assert tolerance("same-renderer") is SAME_RENDERER or tolerance("same-renderer") == SAME_RENDERER
     with pytest.raises(InvalidArgument, match="tolerance='nearby' \\(str\\)"):
         tolerance("nearby")
+
+
+def test_flips_error_reaches_no_farther_than_the_kit_evaluates():
+    """compare.flip_mean evaluates FLIP only within FLIP_REACH of a changed pixel: a one-pixel change must
+    give no error beyond it (at flip-evaluator's own default viewing conditions)."""
+    import flip_evaluator
+
+    from conformance.rendering.compare import FLIP_REACH
+
+    rng = np.random.default_rng(0)
+    picture = rng.random((80, 80, 3)).astype(np.float32)
+    changed = picture.copy()
+    changed[40, 40] = 1 - changed[40, 40]
+    errors = np.asarray(flip_evaluator.evaluate(picture, changed, "LDR", applyMagma=False)[0]).reshape(80, 80)
+    rows, columns = np.nonzero(errors)
+    reach = max(np.abs(rows - 40).max(), np.abs(columns - 40).max())
+    assert 0 < reach <= FLIP_REACH, f"a one-pixel change has FLIP errors {reach} pixels away, but should within {FLIP_REACH}"
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_flip_mean_is_the_whole_pictures_mean(seed):
+    """The regions-only FLIP mean equals one evaluation of the whole picture: scattered pixels, a block, an
+    edge of the picture."""
+    import flip_evaluator
+
+    from conformance.rendering.compare import flip_mean
+
+    rng = np.random.default_rng(seed)
+    expected = rng.integers(0, 256, (96, 128, 3), dtype=np.uint8)
+    actual = expected.copy()
+    count = rng.integers(1, 40)
+    rows, columns = rng.integers(0, 96, count), rng.integers(0, 128, count)
+    actual[rows, columns] = rng.integers(0, 256, (count, 3))
+    actual[0:10, 100:128] = rng.integers(0, 256, 3)  # a block at the picture's edge
+    whole = float(flip_evaluator.evaluate(expected.astype(np.float32) / 255, actual.astype(np.float32) / 255, "LDR",
+                                          applyMagma=False)[1])
+    assert flip_mean(expected, actual) == pytest.approx(whole, rel=1e-4)
+    assert flip_mean(expected, expected.copy()) == 0.0

@@ -169,3 +169,24 @@ def test_teleport_check_runs_at_least_one_step_whatever_hypothesis_draws():
 
     draw()
     assert min(frames_seen) >= 1, f"frames={frames_seen}, but every run should step at least once"
+
+
+@pytest.mark.skipif(backends.NAME != "vtk", reason="VTK's wrappers: the backend keeps them alive between frames")
+def test_an_actor_whose_points_a_sync_swapped_is_read_as_it_is_now():
+    """The VTK backend keeps the wrappers of an actor's arrays alive between frames (conformance.backends.vtk._input):
+    a sync that gives the actor new points, or a new polydata, is still read from what the actor holds now."""
+    from fury import actor as fury_actor
+    from vtkmodules.util import numpy_support
+    from vtkmodules.vtkCommonCore import vtkPoints
+
+    box = fury_actor.box(np.zeros((1, 3)))
+    before = backends.world_vertices(box).copy()
+    points = vtkPoints()
+    points.SetData(numpy_support.numpy_to_vtk(before + [1.0, 2.0, 3.0], deep=True))
+    box.GetMapper().GetInput().SetPoints(points)
+    assert np.allclose(backends.world_vertices(box), before + [1.0, 2.0, 3.0])
+    data = box.GetMapper().GetInput().NewInstance()
+    data.DeepCopy(box.GetMapper().GetInput())
+    data.GetPoints().SetData(numpy_support.numpy_to_vtk(before - 5.0, deep=True))
+    box.GetMapper().SetInputData(data)
+    assert np.allclose(backends.world_vertices(box), before - 5.0)

@@ -139,8 +139,14 @@ def transformed(points: np.ndarray, matrix: np.ndarray) -> np.ndarray:
 def turned_normals(normals: np.ndarray, matrix: np.ndarray) -> np.ndarray:
     """Normals through the inverse transpose of ``matrix``'s linear part, unit length: how both
     renderers light stored normals under an actor's transform."""
-    turned = np.asarray(normals, dtype=np.float64) @ np.linalg.inv(matrix[:3, :3])
+    linear = matrix[:3, :3]
+    # an actor drawn in world coordinates (a shared actor's matrix is the identity): nothing to invert, every frame
+    turned = (np.array(normals, dtype=np.float64) if np.array_equal(linear, _IDENTITY)
+              else np.asarray(normals, dtype=np.float64) @ np.linalg.inv(linear))
     return turned / np.linalg.norm(turned, axis=1, keepdims=True)
+
+
+_IDENTITY = np.eye(3)
 
 
 # -- the flat ID render (the silhouette check) ------------------------------------------------------
