@@ -28,7 +28,7 @@ counterparts in ``right_syncs_vtk``; ``right_syncs`` picks this module or that o
   so it builds ``Rz(z)·Ry(y)·Rx(x)`` in radians, and the angles come from ``Rotation.as_euler("xyz")``
   (pybullet's getEulerFromQuaternion convention, in float64); pybullet's matrices for shared actors,
   row by row in a Python loop.
-* :class:`PerTargetSync` — the plainest loop: scipy pose per target, ``local.matrix`` or vertex
+* :class:`PerTargetSync` — the plainest loop: a pose per target (pybullet's matrix, scipy for a base's inertial offset), ``local.matrix`` or vertex
   rewrite, ``update_full()``; each method is a step that ``wrong_syncs`` gets wrong in one way.
 """
 

@@ -23,11 +23,13 @@ counterparts in ``right_syncs_pygfx``; ``right_syncs`` picks this module or that
   (``vtkProp3D::ComputeMatrix`` does RotateZ, RotateX, RotateY, each about the already turned
   axes), so the angles come from ``Rotation.as_euler("ZXY")``; pybullet's matrices for shared
   actors, row by row in a Python loop.
-* :class:`PerTargetSync` — the plainest loop: scipy pose per target, user matrix or vertex rewrite,
+* :class:`PerTargetSync` — the plainest loop: a pose per target (pybullet's matrix, scipy for a base's inertial offset), user matrix or vertex rewrite,
   ``fury.utils.update_actor``; each method is a step that ``wrong_syncs`` gets wrong in one way.
 """
 
 from __future__ import annotations
+
+import weakref
 
 from fury import utils
 from vtkmodules.util import numpy_support
@@ -45,11 +47,25 @@ def _user_matrix(matrix) -> vtkMatrix4x4:
     return user
 
 
+_VIEWS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _vertex_view(actor):
+    """``utils.vertices_from_actor(actor)``, made once per points array the actor holds: a view of VTK's
+    points stays the points while the actor keeps them (FURY's decorator on it inspects the call's
+    signature every time, which a sync written for speed does not pay a target a frame)."""
+    points = actor.GetMapper().GetInput().GetPoints()
+    kept = _VIEWS.get(actor)
+    if kept is None or kept[0] is not points:
+        kept = _VIEWS[actor] = (points, utils.vertices_from_actor(actor))
+    return kept[1]
+
+
 class _Arrays(sync_steps.ActorArrays):
     """Where a FURY 0.12 actor keeps its vertices and normals: its polydata's arrays, seen through numpy,
     which VTK draws again only once they are marked ``Modified()``."""
 
-    vertex_view = staticmethod(utils.vertices_from_actor)
+    vertex_view = staticmethod(_vertex_view)
 
     @staticmethod
     def normal_view(actor):

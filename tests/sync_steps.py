@@ -143,6 +143,8 @@ class PerTargetSteps(ActorArrays):
         self.targets = list(world.targets)
         # Inverse of each base's local inertial frame: getBasePositionAndOrientation is the COM frame.
         self.to_link = link_frame_offsets(self.p, self.targets)
+        # Bases whose centre of mass is their link frame: their pose as pybullet gives it, no composing
+        self.at_com = {body for body, (offset, back) in self.to_link.items() if not offset.any() and not back.magnitude()}
         # Shared actors: the geometry of each vertex range in its link frame, captured once.
         self.local, self.local_normals = {}, {}
         for t in self.targets:
@@ -158,13 +160,16 @@ class PerTargetSteps(ActorArrays):
         if t.link >= 0:
             return self.p.getLinkState(t.body, t.link, computeForwardKinematics=1)[4:6]
         com_pos, com_orn = self.p.getBasePositionAndOrientation(t.body)
+        if t.body in self.at_com:
+            return com_pos, com_orn
         offset, back = self.to_link[t.body]
         com = Rotation.from_quat(com_orn)
         return com.apply(offset) + com_pos, (com * back).as_quat()
 
     def matrix(self, orn) -> np.ndarray:
-        """3×3 rotation matrix of a pybullet quaternion."""
-        return Rotation.from_quat(orn).as_matrix()
+        """3×3 rotation matrix of a pybullet quaternion: pybullet's own nine numbers, row by row (a scipy
+        ``Rotation`` a target a frame made most of a brick wall's sync, 40 µs each)."""
+        return np.reshape(self.p.getMatrixFromQuaternion(orn), (3, 3))
 
     def to_sync(self):
         return self.targets
