@@ -258,3 +258,20 @@ def test_a_vertex_two_frames_hold_on_the_probe_ticks_goes_to_the_one_that_holds_
     assert 2 not in attachment._probes(ticks)
     found = attachment.attach(vertices, positions, rotations, centres=np.zeros((2, 3)), radii=np.array([1.0, 1.0]))
     assert found.frame.tolist() == [0] and found.held.all(), (found.frame, found.error.max())
+
+
+def test_a_still_vertex_is_measured_from_its_first_tick_and_a_moving_one_from_its_median():
+    """attachment._centres: a vertex whose coordinates stay within ``still`` of the first tick's is measured
+    from those (the median over every tick was most of judging a racecar); one that moves more, from its
+    median; either way its errors are the median's to within ``still``, so whether it is held cannot change."""
+    from conformance.apps import attachment
+
+    rng = np.random.default_rng(0)
+    local = np.empty((9, 2, 3))
+    local[:, 0] = 1.0 + rng.normal(scale=1e-9, size=(9, 3))  # float noise
+    local[:, 1] = rng.normal(size=(9, 3))  # a vertex drawn anywhere
+    still = np.full(2, 1e-6)
+    centres = attachment._centres(local, still)
+    assert np.array_equal(centres[0], local[0, 0])
+    assert np.array_equal(centres[1], np.median(local[:, 1], axis=0))
+    assert np.all(np.abs(attachment._errors(local, still) - attachment._errors(local)) <= still[:, None])

@@ -55,7 +55,10 @@ def test_a_link_drawn_as_its_visual_shape_is_on_it():
     (INERTIAL, "com-frame"),                          # drawn at the centre of mass (getLinkState()[0:2])
     (tuple(2 * np.asarray(INERTIAL)), "offset-sign"),  # the offset added where it should be taken away
     (tuple(-np.asarray(INERTIAL)), "offset-sign"),     # the offset taken away twice
-    ((0.0, 0.0, 0.05), ""),                           # 5 cm up "so it does not sink": outside the catalogue
+    # 4 cm up "so it does not sink": outside the catalogue, and inside the frame's reach (5 cm, the default
+    # bounding radius of a mesh shape whose vertices were not read: at 5 cm the float noise of the drawn centre
+    # decided whether it was "another body's")
+    ((0.0, 0.0, 0.04), ""),
 ])
 def test_a_link_drawn_off_its_visual_shape_fails_with_the_mistake_named(offset, diagnosis):
     placed = _drawn(_leg_frame(), _leg_in_link_frame(offset))

@@ -9,8 +9,11 @@ hour or more here: ``python -m conformance mutants --results … --out docs/muta
 
 from __future__ import annotations
 
+import threading
+
 import pytest
 
+import background
 from conformance import backends
 from conformance.discrimination import mutants
 from conformance.discrimination.verdicts import Outcome
@@ -80,8 +83,7 @@ def test_the_verdicts_file_is_read_and_checked(tmp_path):
     path.write_text("short equivalent\n", encoding="utf-8")
     with pytest.raises(mutants.ConformanceError, match="1: should be"):
         mutants.read_verdicts(path)
-    assert set(mutants.read_verdicts()) <= {m.id for n in mutants.target_names() for m in mutants.generate(mutants.TARGETS[n]())} | set(
-        mutants.read_verdicts()), "the kept verdicts parse"
+    assert set(mutants.read_verdicts()) <= set(_made()) | set(mutants.read_verdicts()), "the kept verdicts parse"
 
 
 def _hand_made(source: str, factory: str = "Sync") -> mutants.Result:
@@ -102,13 +104,42 @@ def test_hand_made_mutants_are_classified_by_a_real_run(source, state):
     assert result.state == state, result
 
 
+_MADE: dict = {}
+_MADE_LOCK = threading.Lock()
+
+
+def _made() -> dict:
+    """Every mutant the kit makes, by id: ``(target name, mutant)``, made once a session (a making of all
+    of them costs seconds, and each sample test made them all again)."""
+    with _MADE_LOCK:
+        if not _MADE:
+            _MADE.update({m.id: (name, m) for name in mutants.target_names() for m in mutants.generate(mutants.TARGETS[name]())})
+    return _MADE
+
+
+def _sample_run(ident: str):
+    """The run judging sample mutant ``ident`` (key and callable for :mod:`background`); None if it is no
+    longer made."""
+
+    def judge():
+        found = _made().get(ident)
+        return None if found is None else mutants.judge(mutants.TARGETS[found[0]](), found[1])
+
+    return f"mutant:{ident}", judge
+
+
+def background_runs(items) -> dict:
+    """The sample's runs start with the session, beside this process's other tests (``background``)."""
+    return dict((key, (0.5, call)) for item in items if item.originalname == "test_the_fast_sample_is_killed"
+                for key, call in [_sample_run(item.callspec.params["ident"])])
+
+
 @pytest.mark.parametrize("ident", mutants.SAMPLE.get(backends.NAME, ()))
 def test_the_fast_sample_is_killed(ident):
     """The fixed sample of the full run's mutants (each killed by an early check there) must stay killed:
     a change to a check that lets one through fails here, per commit, before the hour-long full run."""
-    found = {m.id: (name, m) for name in mutants.target_names() for m in mutants.generate(mutants.TARGETS[name]())}
-    assert ident in found, (f"sample mutant {ident} is no longer made (its code changed): pick another from the full "
-                            "run's page and update conformance.discrimination.mutants.SAMPLE")
-    name, mutant = found[ident]
-    result = mutants.judge(mutants.TARGETS[name](), mutant)
+    result = background.result(*_sample_run(ident))
+    assert result is not None, (f"sample mutant {ident} is no longer made (its code changed): pick another from the full "
+                                "run's page and update conformance.discrimination.mutants.SAMPLE")
+    mutant = _made()[ident][1]
     assert result.state == "killed", f"{mutant.function} line {mutant.line}:\n{mutant.diff}{result}"
