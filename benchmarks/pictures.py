@@ -9,7 +9,9 @@ of the scene and the reference sync. Against it, in the same rounds:
   skipped when no pixel differs) and of pictures one frame apart (FLIP computed);
 * **pyBullet-renderer check**: the silhouette check as the conformance checks make it (FURY's flat ID
   render, pyBullet's ``getCameraImage`` segmentation mask with its tiny renderer, the per-target
-  IoU), and each of its two renders alone.
+  IoU), and each of its two renders alone;
+* **the frame checks**: what every checked frame costs beside its step and sync, ``Kit.assert_frame``
+  (vertices and normals against pyBullet's link frames, announcements), no picture.
 
 The scenes are the kit's own, at a frame in the middle of the action, synced by ``reference``.
 """
@@ -44,8 +46,13 @@ class PictureFigure(RatioToBaseline):
 
 def measure(scene_name: str, *, repeats: int, number: int = 1) -> list[PictureFigure]:
     """Every picture cost of ``scene_name`` against one of its frames."""
+    from conformance.checks.pytest_helpers import Kit
+    from conformance.judge.tolerances import DEFAULT
+
     spec = scenes.get(scene_name)
-    with runner.running(scene_name, sync.load("reference")) as run:
+    reference = sync.load("reference")
+    kit = Kit(reference, DEFAULT)
+    with runner.running(scene_name, reference) as run:
         run.advance(spec.poster_step or spec.steps // 2)
         scene, drawing = run.scene, run.drawing
         camera, size = scene.camera, tuple(scene.image_size)
@@ -82,6 +89,7 @@ def measure(scene_name: str, *, repeats: int, number: int = 1) -> list[PictureFi
             Candidate("pyBullet-renderer (silhouette) check", silhouette_check),
             Candidate("… of which FURY's flat ID render", fury_ids),
             Candidate("… of which pyBullet's `getCameraImage` (tiny renderer)", pybullet_ids),
+            Candidate("the frame checks (`Kit.assert_frame`: vertices, normals, announcements)", lambda: kit.assert_frame(run)),
         ]
         best = race(candidates, repeats=repeats, number=number)
     return [PictureFigure(scene_name, name, seconds, best[FRAME], size) for name, seconds in best.items()]
