@@ -95,13 +95,13 @@ def faces(showm, actors, cam, size, gpu=None) -> dict:
                 prop.SetVisibility(0)
                 undo.append(lambda prop=prop: prop.SetVisibility(1))
         start = 0
-        for actor, data, first in zip(actors, datas, corners):
+        for actor, data, face_corners in zip(actors, datas, corners):
             mapper = actor.GetMapper()
             cells = data.GetCellData()
             active = cells.GetScalars()
-            codes = numpy_support.numpy_to_vtk(colours[start:start + len(first)], deep=True)
+            codes = numpy_support.numpy_to_vtk(colours[start:start + len(face_corners)], deep=True)
             codes.SetName(_ARRAY)
-            start += len(first)
+            start += len(face_corners)
             cells.SetScalars(codes)
             flat = vtkProperty()
             flat.DeepCopy(actor.GetProperty())
