@@ -16,12 +16,14 @@ the main thread in a matmul of the app judge and a run's thread in ``blas_thread
 from __future__ import annotations
 
 import os
+import subprocess
+import threading
 from concurrent.futures import Future, ThreadPoolExecutor
 from typing import Callable
 
 from threadpoolctl import threadpool_limits
 
-__all__ = ["OWN_SYNCS", "one_blas_thread", "result", "start_all", "stop"]
+__all__ = ["HOME", "OWN_SYNCS", "one_blas_thread", "result", "start_all", "stop"]
 
 #: The options of a run of the kit's own syncs (``tests/*_syncs.py``): in pytest's own process, as they do
 #: not crash; a pytest-xdist worker of its own cost each run 2.5 s of CPU more (``test_discrimination``).
@@ -29,6 +31,29 @@ OWN_SYNCS = ["--conformance-isolation", "none"]
 
 _pool: ThreadPoolExecutor | None = None
 _futures: dict[str, Future] = {}
+_PREFIX = "kit-run"
+
+#: The directory the session started in, where every run of the pool starts (:func:`_started_at_home`).
+HOME = os.getcwd()
+
+
+def _started_at_home() -> None:
+    """Every subprocess a thread of the pool starts without a ``cwd`` of its own starts in :data:`HOME`, not
+    wherever this process stands when it starts. Tests run the kit's commands in a directory of their own by
+    changing this process's (``os.chdir``, ``monkeypatch.chdir``), and a run the pool started meanwhile ran
+    there: test_animation found a background run's ``.hypothesis`` in its temporary directory (FURY 2,
+    2026-11-28), and a test's ``pytest.ini`` there would configure a kill-rate run."""
+    original = subprocess.Popen.__init__
+    if getattr(original, "_kit_home", False):
+        return
+
+    def __init__(self, *args, **kwargs):
+        if len(args) < 9 and kwargs.get("cwd") is None and threading.current_thread().name.startswith(_PREFIX):
+            kwargs["cwd"] = HOME
+        original(self, *args, **kwargs)
+
+    __init__._kit_home = True
+    subprocess.Popen.__init__ = __init__
 
 
 def one_blas_thread() -> None:
@@ -41,7 +66,8 @@ def _executor() -> ThreadPoolExecutor:
     global _pool
     if _pool is None:
         one_blas_thread()
-        _pool = ThreadPoolExecutor(max_workers=os.cpu_count() or 1, thread_name_prefix="kit-run")
+        _started_at_home()
+        _pool = ThreadPoolExecutor(max_workers=os.cpu_count() or 1, thread_name_prefix=_PREFIX)
     return _pool
 
 

@@ -58,6 +58,10 @@ def pytest_runtestloop(session):
         planner = getattr(module, "background_runs", None)
         if planner is not None:
             runs.update(planner([item for item in session.items if getattr(item, "module", None) is module]))
+    if runs:  # the runs' apps, forked by the app server, start where it did: here, before any test changes directory
+        from conformance.apps import launch
+
+        launch.start_server()
     background.start_all(runs)
 
 

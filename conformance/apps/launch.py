@@ -25,7 +25,7 @@ from pathlib import Path
 from conformance.apps import recording as recording_mod
 from conformance.errors import ConformanceError
 
-__all__ = ["AppFailed", "KitFailed", "record"]
+__all__ = ["AppFailed", "KitFailed", "record", "start_server"]
 
 #: seconds an app's whole run may take before the kit stops it
 DEFAULT_TIMEOUT = 300.0
@@ -89,6 +89,12 @@ def _forkserver():
             _server.set_forkserver_preload(["conformance.apps.preload"])
             _start_quietly()
         return _server
+
+
+def start_server() -> None:
+    """Start the app server now, if it is not running: its apps start in the directory it started in, so a
+    process whose tests change directory starts it before they do (``tests/conftest.py``)."""
+    _forkserver()
 
 
 def _start_quietly() -> None:
