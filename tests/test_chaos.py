@@ -8,6 +8,8 @@ from conformance import scenes
 from conformance.checks import determinism
 from conformance.bullet import state
 
+pytestmark = pytest.mark.fury_free("its verdict cannot depend on the FURY: pyBullet alone")
+
 
 @pytest.mark.parametrize("scene_name", scenes.names())
 def test_chaotic_after_is_where_a_nanometre_nudge_diverges(scene_name):

@@ -37,6 +37,7 @@ def _missing(tmp_path: Path, backend: str) -> list[str]:
     return done.stdout.split()
 
 
+@pytest.mark.fury_free("its verdict cannot depend on the FURY: the kit's bash script, its probes faked")
 @pytest.mark.parametrize("backend", ["vtk", "pygfx"])
 def test_a_library_listed_is_found_every_time(tmp_path, backend):
     """With every library listed, the library probes find each one on every try (20 tries)."""
@@ -47,6 +48,7 @@ def test_a_library_listed_is_found_every_time(tmp_path, backend):
     assert all(a == answers[0] for a in answers), f"different answers: {answers}"
 
 
+@pytest.mark.fury_free("its verdict cannot depend on the FURY: the kit's bash script, its probes faked")
 def test_a_library_not_listed_is_missing(tmp_path):
     """The probe can fail: a library ldconfig does not list is named for installation."""
     _fake_ldconfig(tmp_path, [name for name in LIBRARIES if name != "libvulkan.so.1"])
@@ -66,6 +68,7 @@ def _fake_python3(directory: Path, fury: str | None) -> None:
     script.chmod(script.stat().st_mode | stat.S_IEXEC)
 
 
+@pytest.mark.fury_free("its verdict cannot depend on the FURY: the kit's bash script, its probes faked")
 @pytest.mark.parametrize("fury, backend", [("2.0.0", "pygfx"), ("0.12.0", "vtk"), ("2.1.0", "fury21")])
 def test_without_backend_the_kit_follows_the_fury_you_have(tmp_path, fury, backend):
     """Issue 30, point 6: ``./kit run`` meant FURY 0.12 whatever the user had; it follows the FURY of

@@ -11,6 +11,8 @@ import pytest
 
 import imports
 
+pytestmark = pytest.mark.fury_free("its verdict cannot depend on the FURY: it reads the kit's sources")
+
 #: The layers, bottom first: what each holds (module names, or a package's prefix ending in ".").
 #: A module may import its own layer and those before it.
 LAYERS = [

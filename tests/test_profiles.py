@@ -22,6 +22,7 @@ def test_small(x):
 """
 
 
+@pytest.mark.fury_free("its verdict cannot depend on the FURY: Hypothesis alone, in a pytester run")
 @pytest.mark.parametrize("profile, shrunk", [("default", False), ("shrink", True), ("ci", True)])
 def test_a_counter_example_is_shrunk_only_where_the_profile_says(pytester, profile, shrunk):
     pytester.makepyfile(test_property=PROPERTY)

@@ -105,3 +105,20 @@ def test_the_fast_tier_leaves_out_full_tests_and_says_so(pytester):
     full.assert_outcomes(passed=2)
     asked = pytester.runpytest("-p", "no:randomly", "test_some.py::test_slow")  # named by its node id: it runs
     asked.assert_outcomes(passed=1)
+
+
+def test_a_fury_free_test_runs_in_one_suite_when_both_run_at_once(pytester, monkeypatch):
+    """``./kit test --backend all`` runs the two suites at once and sets ``KIT_SUITE_BESIDE=vtk`` in FURY 2's:
+    a test whose verdict cannot depend on the FURY runs in FURY 0.12's suite only, and the header says so."""
+    import tiers
+
+    pytester.makeconftest("pytest_plugins = ['tiers']")
+    pytester.makepyfile(test_some="import pytest\n\n@pytest.mark.fury_free('a bash script alone, here')\n"
+                                  "def test_bash():\n    pass\n\ndef test_fury():\n    pass\n")
+    monkeypatch.delenv(tiers.BESIDE, raising=False)
+    alone = pytester.runpytest("-p", "no:randomly")
+    alone.assert_outcomes(passed=2)
+    monkeypatch.setenv(tiers.BESIDE, "vtk")
+    beside = pytester.runpytest("-p", "no:randomly", "-v")
+    beside.assert_outcomes(passed=1, deselected=1)
+    beside.stdout.fnmatch_lines(["*`fury_free` are left to the vtk suite*", "*test_fury PASSED*"])

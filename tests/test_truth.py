@@ -4,11 +4,14 @@ from __future__ import annotations
 
 import numpy as np
 import pybullet
+import pytest
 from hypothesis import given, settings, strategies as st
 
 from conformance.checks import strategies
 from conformance.bullet import truth
 from conformance.bullet.client import BoundClient
+
+pytestmark = pytest.mark.fury_free("its verdict cannot depend on the FURY: pyBullet alone")
 
 sizes = st.floats(0.05, 0.5)
 offsets = st.tuples(*[st.floats(-0.3, 0.3)] * 3)
