@@ -322,7 +322,9 @@ def _off_the_world(vertices, pos, rot, best, best_spread, allowance, outside, to
     spreads = np.where(gaps <= ON_SHAPE, spreads, np.inf)
     pick = np.argmin(spreads, axis=1)
     spread = spreads[np.arange(len(rows)), pick]
-    rows, chosen, spread = rows[np.isfinite(spread)], candidates[np.arange(len(rows)), pick][np.isfinite(spread)], spread[np.isfinite(spread)]
+    chosen = candidates[np.arange(len(rows)), pick]
+    found = np.isfinite(spread)  # on some body's shape, among the nearest
+    rows, chosen, spread = rows[found], chosen[found], spread[found]
     trial = best.copy()
     trial[rows] = chosen
     ok = spread <= _allowance(vertices, pos, rot, trial, tolerance)[rows]
