@@ -206,8 +206,14 @@ def attach(vertices: np.ndarray, positions: np.ndarray, rotations: np.ndarray, *
     best_spread = spreads[everyone, choice] if n else np.zeros(0)
     allowance = _allowance(vertices, pos, rot, best, tolerance)
     if outside is not None and n and frames > FIRST:
-        _off_the_world(vertices, pos, rot, best, best_spread, allowance, outside, tolerance,
-                       lambda rows: nearest(rows, min(frames, NEAREST))[:, :-1], spreads_of)
+        # Held by several of its nearest frames, and on none of their shapes: its own may not be among them.
+        stray = np.zeros(n, dtype=bool)
+        tied_rows = np.flatnonzero((holding.sum(axis=1) >= 2) & (best < frames))
+        for f in np.unique(best[tied_rows]):
+            mine = tied_rows[best[tied_rows] == f]
+            stray[mine] = outside(int(f), _transposed_times(rot[0, f], vertices[0, mine] - pos[0, f])) > ON_SHAPE
+        _onto_a_shape(vertices, pos, rot, best, best_spread, allowance, outside, tolerance,
+                      lambda rows: nearest(rows, min(frames, NEAREST))[:, :-1], spreads_of, stray)
         allowance = _allowance(vertices, pos, rot, best, tolerance)
     for k in (NEAREST, frames):
         loose = np.flatnonzero(best_spread > allowance)
@@ -301,16 +307,18 @@ def _with_the_majority(vertices, pos, rot, best, welded, allowance, error, toler
     return moved
 
 
-def _off_the_world(vertices, pos, rot, best, best_spread, allowance, outside, tolerance, near, spreads_of) -> None:
-    """Give each vertex the world holds to a body among its :data:`NEAREST` frames that holds it as well and
-    whose shape it lies on (``best``, ``best_spread`` changed in place). The world holds whatever stood
-    still during the probe ticks, with an allowance as wide as the world's drawing: a brick's corner, as near
-    eight brick centres as it is to its own brick's, may have four other bricks as its :data:`FIRST`
-    nearest; they moved, so the world took it, and held it by a hair once its own brick was kicked a
-    little (0.994 of the world's allowance: the app precision measurement's wrecking ball, seed 6). A
-    vertex on no body's shape (scenery, a drawn floor with no body) stays with the world."""
+def _onto_a_shape(vertices, pos, rot, best, best_spread, allowance, outside, tolerance, near, spreads_of, stray) -> None:
+    """Give each vertex the world holds, and each ``stray`` one (held by several frames, on none of their shapes),
+    to a frame among its :data:`NEAREST` that holds it as well and whose shape it lies on (``best``, ``best_spread``
+    changed in place); the :data:`FIRST` nearest by shape centre need not hold its own. The world holds whatever
+    stood still during the probe ticks, with an allowance as wide as the world's drawing: a brick's corner, as
+    near eight brick centres as its own brick's, had four other bricks as its nearest; they moved, the world
+    took it and held it by a hair once its brick was kicked a little (0.994 of the allowance: the app precision
+    measurement's wrecking ball, seed 6). A ball-pit floor's corner had two walls and two resting balls as its
+    nearest, all still: it went to a wall it does not lie on, and was placed 2.3 m off that wall's centre (the
+    ball pit, FURY 2, seed 9). A vertex on no shape (scenery, a floor drawn with no body) stays where it was."""
     frames = pos.shape[1] - 1
-    rows = np.flatnonzero((best == frames) & (best_spread <= allowance))
+    rows = np.flatnonzero(((best == frames) | stray) & (best_spread <= allowance))
     if not len(rows):
         return
     candidates = near(rows)
