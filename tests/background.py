@@ -7,12 +7,6 @@ test module for the runs it will need (its ``background_runs(items)``: key -> (p
 and starts them all at once, longest first, one per core. A test then waits for its run's result.
 Under pytest-xdist the workers already share the cores: each run is started when its test asks.
 
-A run that is a call of the kit's own code, not a command (an :class:`InWorker`: ``test_examples``'
-judgement of each example app), goes to one worker process kept for the session, which makes them one
-after the other beside this process: in this process they were a third of FURY 2's suite's own time, and
-that process was the suite's critical path (``docs/numbers.md``, "Tiers"). One worker, not a process a
-run: an interpreter that imports the kit costs about 2 s of CPU, and an app's judgement 1-27 s.
-
 This process is then single-threaded in BLAS (:func:`one_blas_thread`): the runs start their processes
 from threads while the main thread computes, and a fork while the main thread is inside a multi-threaded
 OpenBLAS call deadlocks both, in OpenBLAS's own fork handler (measured: a ``./kit test`` hung for good with
@@ -21,24 +15,21 @@ the main thread in a matmul of the app judge and a run's thread in ``blas_thread
 
 from __future__ import annotations
 
-import multiprocessing
 import os
 import subprocess
 import threading
-from concurrent.futures import Future, ProcessPoolExecutor, ThreadPoolExecutor
-from dataclasses import dataclass, field
-from typing import Any, Callable
+from concurrent.futures import Future, ThreadPoolExecutor
+from typing import Callable
 
 from threadpoolctl import threadpool_limits
 
-__all__ = ["HOME", "OWN_SYNCS", "InWorker", "one_blas_thread", "result", "start_all", "stop"]
+__all__ = ["HOME", "OWN_SYNCS", "one_blas_thread", "result", "start_all", "stop"]
 
 #: The options of a run of the kit's own syncs (``tests/*_syncs.py``): in pytest's own process, as they do
 #: not crash; a pytest-xdist worker of its own cost each run 2.5 s of CPU more (``test_discrimination``).
 OWN_SYNCS = ["--conformance-isolation", "none"]
 
 _pool: ThreadPoolExecutor | None = None
-_worker: ProcessPoolExecutor | None = None
 _futures: dict[str, Future] = {}
 _PREFIX = "kit-run"
 
@@ -71,43 +62,6 @@ def one_blas_thread() -> None:
     threadpool_limits(limits=1, user_api="blas")
 
 
-@dataclass(frozen=True)
-class InWorker:
-    """A run that is ``fn(*args, **kwargs)`` (picklable: a module-level function of the kit), made in the
-    session's worker process when started with the session, in this process when its test asks first."""
-
-    fn: Callable[..., Any]
-    args: tuple = ()
-    kwargs: dict = field(default_factory=dict)
-
-    def __call__(self):
-        return self.fn(*self.args, **self.kwargs)
-
-
-def _quiet_worker() -> None:
-    """The worker computes BLAS on one thread, as this process does, and imports pyBullet with its stderr
-    nowhere: pyBullet's "build time" line would land in the middle of pytest's progress."""
-    one_blas_thread()
-    saved, nowhere = os.dup(2), os.open(os.devnull, os.O_WRONLY)
-    os.dup2(nowhere, 2)
-    try:
-        import pybullet  # noqa: F401
-    finally:
-        os.dup2(saved, 2)
-        os.close(saved)
-        os.close(nowhere)
-
-
-def _judge() -> ProcessPoolExecutor:
-    """The session's worker process: spawned, so it starts single-threaded from this process's ``sys.path``,
-    environment and directory (:data:`HOME`: the session starts it before any test moves)."""
-    global _worker
-    if _worker is None:
-        _worker = ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context("spawn"),
-                                      initializer=_quiet_worker)
-    return _worker
-
-
 def _executor() -> ThreadPoolExecutor:
     global _pool
     if _pool is None:
@@ -121,30 +75,22 @@ def start_all(runs: dict[str, tuple[float, Callable[[], object]]]) -> None:
     """Start every run not started yet, highest priority (longest) first."""
     for key, (_, call) in sorted(runs.items(), key=lambda kv: -kv[1][0]):
         if key not in _futures:
-            if isinstance(call, InWorker):
-                _futures[key] = _judge().submit(call.fn, *call.args, **call.kwargs)
-            else:
-                _futures[key] = _executor().submit(call)
+            _futures[key] = _executor().submit(call)
 
 
 def result(key: str, call: Callable[[], object]):
-    """The result of run ``key``, started now if it was not started with the session (an :class:`InWorker`
-    is then made here, in this thread: nothing else is running it)."""
+    """The result of run ``key``, started now if it was not started with the session."""
     if key not in _futures:
-        if isinstance(call, InWorker):
-            return call()
         _futures[key] = _executor().submit(call)
     return _futures[key].result()
 
 
 def stop() -> None:
     """Cancel what has not started; wait for what has (their processes end on their own)."""
-    global _pool, _worker
+    global _pool
     for future in _futures.values():
         future.cancel()
     if _pool is not None:
         _pool.shutdown(wait=True)
-    if _worker is not None:
-        _worker.shutdown(wait=True, cancel_futures=True)
-    _pool = _worker = None
+    _pool = None
     _futures.clear()

@@ -41,20 +41,3 @@ def test_a_run_started_while_a_test_stands_elsewhere_starts_where_the_session_di
         pool.shutdown()
     assert where == background.HOME != str(tmp_path), f"a run of the pool started in {where}, but should in {background.HOME}"
     assert here == str(tmp_path), "the test's own commands still start where it stands"
-
-
-def test_a_call_of_the_kit_runs_in_the_sessions_worker_process_and_its_result_comes_back(monkeypatch):
-    """``test_examples``' judgements run in one worker process beside this one (``InWorker``), and the test
-    reads what that process made; a call its test asks for before any start is made here."""
-    import os
-
-    monkeypatch.setattr(background, "_worker", None)
-    monkeypatch.setattr(background, "_futures", {})
-    call = background.InWorker(os.getpid)
-    background.start_all({"pid": (0, call)})
-    try:
-        there = background.result("pid", call)
-    finally:
-        background._worker.shutdown()
-    assert isinstance(there, int) and there != os.getpid(), f"the call ran in process {there}, but should in the worker"
-    assert background.result("not started", call) == os.getpid()
