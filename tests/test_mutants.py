@@ -9,6 +9,7 @@ hour or more here: ``python -m conformance mutants --results … --out docs/muta
 
 from __future__ import annotations
 
+import sys
 import threading
 
 import pytest
@@ -129,9 +130,15 @@ def _sample_run(ident: str):
 
 
 def background_runs(items) -> dict:
-    """The sample's runs start with the session, beside this process's other tests (``background``)."""
-    return dict((key, (0.5, call)) for item in items if item.originalname == "test_the_fast_sample_is_killed"
+    """The sample's runs start with the session, beside this process's other tests (``background``). The
+    mutants are made here first, in this thread: making them imports mutmut and libcst, and an import in
+    a run's thread while a ``pytester`` test in this one puts ``sys.modules`` back as it found it fails
+    mid-way (seen in CI, 2026-11-28: ``KeyError: 'libcst.matchers'``, every sample test failed)."""
+    runs = dict((key, (0.5, call)) for item in items if item.originalname == "test_the_fast_sample_is_killed"
                 for key, call in [_sample_run(item.callspec.params["ident"])])
+    if runs:
+        _made()
+    return runs
 
 
 @pytest.mark.parametrize("ident", mutants.SAMPLE.get(backends.NAME, ()))
@@ -143,3 +150,14 @@ def test_the_fast_sample_is_killed(ident):
                                 "run's page and update conformance.discrimination.mutants.SAMPLE")
     mutant = _made()[ident][1]
     assert result.state == "killed", f"{mutant.function} line {mutant.line}:\n{mutant.diff}{result}"
+
+
+def test_the_sample_s_mutants_are_made_before_its_runs_start(monkeypatch):
+    """The planner makes the mutants in the session's thread, so no run's thread imports mutmut or libcst
+    while a ``pytester`` test puts ``sys.modules`` back (``background_runs``)."""
+    from types import SimpleNamespace
+
+    monkeypatch.setattr(sys.modules[__name__], "_MADE", {})
+    item = SimpleNamespace(originalname="test_the_fast_sample_is_killed", callspec=SimpleNamespace(params={"ident": "any"}))
+    runs = background_runs([item])
+    assert list(runs) == ["mutant:any"] and _MADE, "the sample's runs were planned before its mutants were made"
