@@ -178,3 +178,24 @@ def test_a_golden_failure_s_reproduce_line_keeps_the_golden_dir_and_tolerance_gi
     plain = shlex.split(test_golden._reproduce("test_golden_render", "free_fall", "reference", None,
                                                SimpleNamespace(golden_dir=None, override=None)))
     assert "--conformance-golden-dir" not in plain and "--conformance-image-tolerance" not in plain
+
+
+@pytest.mark.parametrize("differs", ["a second picture of one drawing", "a second build"])
+def test_a_renderer_that_does_not_repeat_itself_fails_the_repeatability_check(differs, monkeypatch):
+    """``test_same_scene_renders_identically`` fails when the renderer gives another picture of the same
+    drawing, and when it draws a second build of the scene otherwise than the first."""
+    from conformance import backends, test_rendering
+
+    real, calls = backends.render, []
+    wrong = {"a second picture of one drawing": 2, "a second build": 3}[differs]  # the check's 2nd and 3rd pictures
+
+    def render(*args, **kwargs):
+        calls.append(None)
+        picture = real(*args, **kwargs).copy()
+        if len(calls) == wrong:
+            picture[0, 0] ^= 255  # one pixel
+        return picture
+
+    monkeypatch.setattr(backends, "render", render)
+    with pytest.raises(AssertionError, match="1 of .* pixels differ"):
+        test_rendering.test_same_scene_renders_identically("free_fall", sync.load("reference"))
