@@ -163,3 +163,24 @@ def test_a_band_s_figure_is_measured_from_the_law_s_value():
     assert use(0.0, low=0.0, high=1e-3) == _pytest.approx(1.0)  # no law's value given: from the middle
     with _pytest.raises(_pytest.fail.Exception, match=r"apex/drop=0.002, but should be in \[0, 0.001\]"):
         assert_in_band("apex/drop", actual=2e-3, low=0.0, high=1e-3, where="[here]", exact=0.0)
+
+
+def test_a_draw_the_kit_fails_on_is_a_rejection_in_the_journal_and_the_run_goes_on(tmp_path, monkeypatch):
+    """The kit's own failure on a right app (here: the judge raising) is that draw's rejection, written to the
+    journal with the error, and the later draws are made and written too; raised, it ended the journal while
+    the pool made every later draw."""
+    from conformance import apps
+
+    calls = []
+
+    def check_app(path, **kwargs):
+        calls.append(path)
+        if len(calls) == 1:
+            raise ValueError("the judge broke")
+        return apps.AppResult(str(path), 120, [], None)  # a right app: no verdict failed
+
+    monkeypatch.setattr(apps, "check_app", check_app)
+    path = tmp_path / "draws.jsonl"
+    draws = precision.app_draws(["a.py", "b.py"], [1], runs=0, journal=precision.Journal(path))
+    assert draws[0].error == "the kit itself failed: ValueError: the judge broke", draws[0]
+    assert {k[1] for k in precision.Journal(path).made} == {"a.py", "b.py"}

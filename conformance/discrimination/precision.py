@@ -231,6 +231,11 @@ def app_draws(paths, seeds, *, runs: int, jobs: int | None = None, timeout: floa
         except apps.AppFailed as err:
             draw.error = str(err)
             draw.reproduce = apps.reproduce_command(str(path), apps.DEFAULT_TICKS)
+        except Exception as err:  # noqa: BLE001 - the kit failed on a right app: a rejection to count, not the end of the run
+            # Raised, it ended the journal: the pool made every later draw and none was written (a FURY 0.12
+            # measurement, 2026-11-28, wrote nothing for 45 minutes after one draw failed this way).
+            draw.error = f"the kit itself failed: {type(err).__name__}: {err}"
+            draw.reproduce = apps.reproduce_command(str(path), apps.DEFAULT_TICKS)
         else:
             for check, verdict in result.verdicts.items():
                 if not verdict.passed:
