@@ -209,9 +209,7 @@ def attach(vertices: np.ndarray, positions: np.ndarray, rotations: np.ndarray, *
         # Held by several of its nearest frames, and on none of their shapes: its own may not be among them.
         stray = np.zeros(n, dtype=bool)
         tied_rows = np.flatnonzero((holding.sum(axis=1) >= 2) & (best < frames))
-        for f in np.unique(best[tied_rows]):
-            mine = tied_rows[best[tied_rows] == f]
-            stray[mine] = outside(int(f), _transposed_times(rot[0, f], vertices[0, mine] - pos[0, f])) > ON_SHAPE
+        stray[tied_rows] = _gaps(outside, vertices, pos, rot, tied_rows, best[tied_rows]) > ON_SHAPE
         _onto_a_shape(vertices, pos, rot, best, best_spread, allowance, outside, tolerance,
                       lambda rows: nearest(rows, min(frames, NEAREST))[:, :-1], spreads_of, stray)
         allowance = _allowance(vertices, pos, rot, best, tolerance)
@@ -274,6 +272,16 @@ def attach(vertices: np.ndarray, positions: np.ndarray, rotations: np.ndarray, *
     return Attachment(frame=frame, error=error, allowance=allowance, reference=reference, tied=tied, welded=welded)
 
 
+def _gaps(outside, vertices, pos, rot, rows, frames) -> np.ndarray:
+    """How far vertex ``rows[i]`` lies outside the shapes of frame ``frames[i]`` (or of each ``frames[i, j]``)
+    at the first tick: ``outside(frame, points in that frame)``, one call per frame."""
+    gaps = np.zeros(frames.shape)
+    for f in np.unique(frames):
+        where = np.nonzero(frames == f)
+        gaps[where] = outside(int(f), _transposed_times(rot[0, f], vertices[0, rows[where[0]]] - pos[0, f]))
+    return gaps
+
+
 def _with_the_majority(vertices, pos, rot, best, welded, allowance, error, tolerance, outside=None) -> np.ndarray:
     """Move to the frame most of the actor's vertices are held by every vertex that frame holds as well and
     that lies on no shape of its own frame (``best`` changed in place; which moved). A point on a joint's
@@ -289,11 +297,7 @@ def _with_the_majority(vertices, pos, rot, best, welded, allowance, error, toler
     majority = int(np.argmax(counts))
     rows = np.flatnonzero(~welded & (best != majority) & (best < frames))
     if outside is not None and len(rows):
-        gaps = np.zeros(len(rows))
-        for f in np.unique(best[rows]):
-            mine = best[rows] == f
-            gaps[mine] = outside(int(f), _transposed_times(rot[0, f], vertices[0, rows[mine]] - pos[0, f]))
-        rows = rows[gaps > ON_SHAPE]
+        rows = rows[_gaps(outside, vertices, pos, rot, rows, best[rows]) > ON_SHAPE]
     if not len(rows):
         return np.zeros(len(best), dtype=bool)
     trial = best.copy()
@@ -323,11 +327,7 @@ def _onto_a_shape(vertices, pos, rot, best, best_spread, allowance, outside, tol
         return
     candidates = near(rows)
     spreads = spreads_of(rows, candidates)
-    gaps = np.full(candidates.shape, np.inf)
-    for f in np.unique(candidates):
-        r, c = np.nonzero(candidates == f)
-        gaps[r, c] = outside(int(f), _transposed_times(rot[0, f], vertices[0, rows[r]] - pos[0, f]))
-    spreads = np.where(gaps <= ON_SHAPE, spreads, np.inf)
+    spreads = np.where(_gaps(outside, vertices, pos, rot, rows, candidates) <= ON_SHAPE, spreads, np.inf)
     pick = np.argmin(spreads, axis=1)
     spread = spreads[np.arange(len(rows)), pick]
     chosen = candidates[np.arange(len(rows)), pick]
