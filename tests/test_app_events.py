@@ -91,3 +91,27 @@ def test_a_floor_corner_with_walls_and_balls_nearest_goes_to_the_floor():
         pytest.skip(f"no ball pit among the {backends.NAME} examples (FURY 2's only)")
     result = apps.check_app(script, ticks=30, events=PIT_EVENTS)
     assert result.verdicts["placed"].passed, result.verdicts["placed"].lines
+
+
+#: The app precision measurement's false alarm at 327295b (FURY 2, seed 10): a teleport of the car and a joint
+#: reset, after which a chassis vertex on the left front wheel's axle was 2.16e-7 m from where the wheel carries it.
+RACECAR_EVENTS = [
+    {"kind": "teleport", "frame": 9, "which": 257, "offset": [-0.3121334944596456, 5.868007548631885e-28, -0.2521486937257051],
+     "orientation": [-1.617397516211997e-15, 0.8001823377750071, 6.350060213679544e-215, 0.5997568059746586]},
+    {"kind": "joint_reset", "frame": 24, "which": 310, "value": 1.628937511196841,
+     "orientation": [-0.0, -0.0, -1.0, -6.123233995736766e-17]},
+]
+
+
+def test_a_chassis_vertex_on_a_wheels_axle_stays_with_the_chassis():
+    """attachment.attach gives a vertex that lies at a small link's origin (on its shape) and that the link
+    carries a float32 hair closer than the chassis it is drawn with to the frame that holds it within that
+    frame's own allowance: the right racecar was rejected by ``attached`` on FURY 2 ("link_actors[0]
+    vertices 195:196 of 200: not held by any frame … worst 2.16e-07 m at tick 26")."""
+    from pathlib import Path
+
+    from conformance import apps, backends
+
+    script = Path(__file__).resolve().parent.parent / "examples" / backends.NAME / "racecar.py"
+    result = apps.check_app(script, ticks=30, events=RACECAR_EVENTS)
+    assert result.verdicts["attached"].passed, result.verdicts["attached"].lines

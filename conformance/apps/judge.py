@@ -135,8 +135,7 @@ class _Judgement:
         verdict = Verdict("attached", True)
         worst = 0.0
         for track, a, mapped in zip(self.r.actors, self.attachments, self.mapped):
-            ratio = a.error / a.allowance[:, None]
-            worst = max(worst, float(ratio.max(initial=0)))
+            ratio = np.max(a.error / a.allowance[:, None], axis=1, initial=0)
             loose = ~a.held & ~mapped
             tied = int(a.tied.sum())
             if tied:
@@ -144,11 +143,16 @@ class _Judgement:
                                      "apart in this run (undecidable; the kit's perturbed runs move bodies apart)")
             soft: dict[tuple, list] = {}  # pieces that follow nodes of one soft body: one line for them all
             for start, stop, frame, diagnosis in self._loose_pieces(track, a, loose):
-                verdict.passed = False
                 rows = np.arange(start, stop)
                 error, allowance = self._errors(track.vertices[1:, rows], frame)
                 bad_ticks = np.flatnonzero(np.any(error > allowance[:, None], axis=0))
-                first = int(bad_ticks[0]) if len(bad_ticks) else 0
+                if not len(bad_ticks):
+                    # The frame it follows holds it at every tick, within the allowance of the piece's own
+                    # reach from that frame: held, and no line may say it left that frame at some tick.
+                    ratio[rows] = np.max(error / allowance[:, None], axis=1)
+                    continue
+                verdict.passed = False
+                first = int(bad_ticks[0])
                 k = int(np.argmax(error.max(axis=0)))
                 self.followed_badly.add(frame)
                 info = self.r.frames[frame] if frame >= 0 else None
@@ -163,6 +167,7 @@ class _Judgement:
                     f"{allowance.max():.3g} m); worst {error[:, k].max():.3g} m at tick {k + 1}")
                 verdict.diagnosed(diagnosis)
             soft_bodies.attached(track, a, soft, verdict)
+            worst = max(worst, float(ratio.max(initial=0)))
         for entry in self.r.mapping:
             self._judge_mapped(entry, verdict)
         welded = sum(int(a.welded.sum()) for a in self.attachments if a.welded is not None)
