@@ -185,6 +185,8 @@ def test_a_renderer_that_does_not_repeat_itself_fails_the_repeatability_check(di
     """``test_same_scene_renders_identically`` fails when the renderer gives another picture of the same
     drawing, and when it draws a second build of the scene otherwise than the first."""
     from conformance import backends, test_rendering
+    from conformance.checks.pytest_helpers import Kit
+    from conformance.judge.tolerances import DEFAULT
 
     real, calls = backends.render, []
     wrong = {"a second picture of one drawing": 2, "a second build": 3}[differs]  # the check's 2nd and 3rd pictures
@@ -198,4 +200,4 @@ def test_a_renderer_that_does_not_repeat_itself_fails_the_repeatability_check(di
 
     monkeypatch.setattr(backends, "render", render)
     with pytest.raises(AssertionError, match="1 of .* pixels differ"):
-        test_rendering.test_same_scene_renders_identically("free_fall", sync.load("reference"))
+        test_rendering.test_same_scene_renders_identically("free_fall", Kit(sync.load("reference"), DEFAULT))
