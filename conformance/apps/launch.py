@@ -25,7 +25,7 @@ from pathlib import Path
 from conformance.apps import recording as recording_mod
 from conformance.errors import ConformanceError
 
-__all__ = ["AppFailed", "KitFailed", "record", "start_server"]
+__all__ = ["AppFailed", "KitFailed", "record", "server", "start", "start_server"]
 
 #: seconds an app's whole run may take before the kit stops it
 DEFAULT_TIMEOUT = 300.0
@@ -80,8 +80,9 @@ _start_lock = threading.Lock()
 _server = None
 
 
-def _forkserver():
-    """The forkserver context whose server has imported :mod:`conformance.apps.preload` (None where there is none)."""
+def server():
+    """The forkserver context whose server has imported :mod:`conformance.apps.preload` (None where there is none):
+    the app processes, and the kit's own pytest runs (:mod:`conformance.discrimination.forked`), are forked from it."""
     global _server
     with _server_lock:
         if _server is None and "forkserver" in multiprocessing.get_all_start_methods():
@@ -94,7 +95,7 @@ def _forkserver():
 def start_server() -> None:
     """Start the app server now, if it is not running: its apps start in the directory it started in, so a
     process whose tests change directory starts it before they do (``tests/conftest.py``)."""
-    _forkserver()
+    server()
 
 
 def _start_quietly() -> None:
@@ -117,13 +118,13 @@ def _run_child(argv: list[str], env: dict, timeout: float, stderr_path: Path) ->
     """Run :func:`conformance.apps.child.main` on ``argv`` in a process of its own with ``env``; its exit
     status (negative: the signal that killed it) and what it wrote to stderr. Raises
     :class:`subprocess.TimeoutExpired` (with that stderr) when it runs past ``timeout``; it is killed then."""
-    server = _forkserver()
-    if server is None:
+    context = server()
+    if context is None:
         command = [sys.executable, "-m", "conformance.apps.child", *argv]
         done = subprocess.run(command, capture_output=True, text=True, timeout=timeout, env=env, stdin=subprocess.DEVNULL)
         return done.returncode, done.stderr
-    process = server.Process(target=_child_main, args=(argv, env, str(stderr_path)), daemon=False)
-    _start(process)
+    process = context.Process(target=_child_main, args=(argv, env, str(stderr_path)), daemon=False)
+    start(process)
     try:
         process.join(timeout)
         timed_out = process.exitcode is None
@@ -136,7 +137,7 @@ def _run_child(argv: list[str], env: dict, timeout: float, stderr_path: Path) ->
     return process.exitcode, _read(stderr_path)
 
 
-def _start(process) -> None:
+def start(process) -> None:
     """Start ``process`` with no main module for multiprocessing to import in it: it would run this
     program's script again there as ``__mp_main__``, and a script that calls :func:`record` at its top level
     (no ``if __name__ == "__main__":``) would call it again and die, silently. Nothing of ``__main__`` is sent."""

@@ -49,6 +49,7 @@ __all__ = [
     "SCREEN",
     "child_environment",
     "close_x_connection",
+    "die_with_parent",
     "dies_with_this_process",
     "ensure_display",
     "on_stop",
@@ -262,6 +263,13 @@ def dies_with_this_process(*, waited_for: bool = False):
             os._exit(1)
 
     return set_death_signal
+
+
+def die_with_parent() -> None:
+    """In a forked process: have the kernel send it ``SIGTERM`` when its parent ends (Linux; no-op elsewhere)."""
+    prctl = _prctl()
+    if prctl is not None:
+        prctl(_PR_SET_PDEATHSIG, signal.SIGTERM, 0, 0, 0)
 
 
 # -- SIGTERM -------------------------------------------------------------------------------------

@@ -99,19 +99,23 @@ def command(spec: str, *, stop_at_first: bool = False, survey: bool = False, pyt
 
 
 def check(spec: str, *, stop_at_first: bool = False, survey: bool = False, pytest_args=(), env=None,
-          timeout: float | None = None) -> Outcome:
+          timeout: float | None = None, fork: bool = True) -> Outcome:
     """Run the sync checks on ``spec`` in a pytest process of its own and read its report. The run's
     pictures go to a temporary directory of its own, so runs side by side never share one. A run still
-    going after ``timeout`` seconds is stopped: no records, and its stderr says so."""
+    going after ``timeout`` seconds is stopped: no records, and its stderr says so. The process is forked
+    from the app server (:mod:`conformance.discrimination.forked`) unless ``fork`` is false or there is none."""
     with tempfile.TemporaryDirectory() as tmp:
         report = os.path.join(tmp, "report.json")
         argv = command(spec, stop_at_first=stop_at_first, survey=survey, pytest_args=list(pytest_args), report=report,
                        results=os.path.join(tmp, "results"))
         from conformance.backends.display import child_environment, dies_with_this_process
+        from conformance.discrimination import forked
 
         try:
-            proc = subprocess.run(argv, capture_output=True, text=True, env=child_environment(env), timeout=timeout,
-                                  preexec_fn=dies_with_this_process(waited_for=True))  # none outlives a killed command
+            proc = forked.run(argv[3:], env=child_environment(env), timeout=timeout) if fork else None
+            if proc is None:
+                proc = subprocess.run(argv, capture_output=True, text=True, env=child_environment(env), timeout=timeout,
+                                      preexec_fn=dies_with_this_process(waited_for=True))  # none outlives a killed command
         except subprocess.TimeoutExpired:
             return Outcome(spec, -9, [], f"the run did not complete within {timeout:g} s and was stopped")
         if not os.path.exists(report):
