@@ -2,9 +2,9 @@
 which has imported pyBullet, FURY and its renderer, numpy, scipy and pytest once.
 
 A wrong sync's run stops at its first failure, often within a second of its start, and starting was
-most of it: a new interpreter spent 2.6 s of CPU on ``wrong_syncs:OneStepLate`` with ``-x`` on FURY 0.12
-and 3.8 s on FURY 2, a process forked from a server that had imported those libraries 1.2 s and 1.6 s
-(measured 2026-11-28, one run each, under load). The kit's own tests make about 40 such runs a FURY.
+much of it: six wrong syncs with ``-x``, one after the other, took 16.8 s of CPU as new processes and 11.8 s
+forked on FURY 0.12, 22.1 s and about 16.8 s on FURY 2 (2026-11-28, process accounting, the server's own
+start-up included): about 1 s a run. The kit's own tests make about 40 such runs a FURY.
 
 The fork behaves as the new process would: it runs in the given directory with the given environment
 (``PYTHONPATH`` put on ``sys.path`` as the interpreter would), its standard streams go to files read back
