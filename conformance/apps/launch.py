@@ -25,7 +25,7 @@ from pathlib import Path
 from conformance.apps import recording as recording_mod
 from conformance.errors import ConformanceError
 
-__all__ = ["AppFailed", "KitFailed", "record", "server", "start", "start_server"]
+__all__ = ["AppFailed", "KitFailed", "read", "record", "server", "start", "start_server"]
 
 #: seconds an app's whole run may take before the kit stops it
 DEFAULT_TIMEOUT = 300.0
@@ -133,8 +133,8 @@ def _run_child(argv: list[str], env: dict, timeout: float, stderr_path: Path) ->
             process.kill()
             process.join()
     if timed_out:
-        raise subprocess.TimeoutExpired(argv, timeout, stderr=_read(stderr_path))
-    return process.exitcode, _read(stderr_path)
+        raise subprocess.TimeoutExpired(argv, timeout, stderr=read(stderr_path))
+    return process.exitcode, read(stderr_path)
 
 
 def start(process) -> None:
@@ -150,7 +150,8 @@ def start(process) -> None:
             sys.modules["__main__"] = main
 
 
-def _read(path: Path) -> str:
+def read(path: Path) -> str:
+    """A child's output file as text (empty if it wrote none)."""
     try:
         return path.read_text(encoding="utf-8", errors="replace")
     except FileNotFoundError:

@@ -18,6 +18,7 @@ import os
 import subprocess
 import sys
 import tempfile
+from pathlib import Path
 
 __all__ = ["run"]
 
@@ -45,15 +46,7 @@ def run(argv: list[str], *, env: dict[str, str], timeout: float | None = None) -
                 process.join()
         if timed_out:
             raise subprocess.TimeoutExpired(argv, timeout)
-        return subprocess.CompletedProcess(argv, process.exitcode, _read(out), _read(err))
-
-
-def _read(path: str) -> str:
-    try:
-        with open(path, encoding="utf-8", errors="replace") as fh:
-            return fh.read()
-    except FileNotFoundError:
-        return ""
+        return subprocess.CompletedProcess(argv, process.exitcode, launch.read(Path(out)), launch.read(Path(err)))
 
 
 def _main(argv: list[str], env: dict[str, str], cwd: str, out: str, err: str) -> None:
