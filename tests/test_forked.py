@@ -1,15 +1,21 @@
 """A pytest run forked from the app server (:mod:`conformance.discrimination.forked`) is the run a new
 process gives: the same exit status and records, the sync found through ``PYTHONPATH``, the kit's asserts
-rewritten (no warning that they could not be), and a run past its time limit stopped."""
+rewritten (no warning that they could not be), a run past its time limit stopped, and what is forked
+for a kit that is killed (a pytest run, an app) ended with it."""
 
 from __future__ import annotations
 
+import contextlib
 import os
+import signal
 import subprocess
+import sys
 import textwrap
+import time
 
 import pytest
 
+from conformance.apps import launch
 from conformance.discrimination import forked, verdicts
 
 #: a sync that draws nothing: fails the first vertex check of free_fall
@@ -52,3 +58,68 @@ def test_a_forked_run_past_its_time_limit_is_stopped(env):
     with pytest.raises(subprocess.TimeoutExpired):
         forked.run(["--pyargs", "conformance", "-q", "-p", "no:cacheprovider", "--sync", "draws_nothing:DrawsNothing",
                     "-k", "tumbling"], env=env, timeout=0.5)
+
+
+#: a check that says where it runs, then waits
+WAITS = textwrap.dedent("""
+    import os, time
+
+    def test_waits():
+        with open(os.environ["KIT_TEST_PIDFILE"], "w") as f:
+            f.write(str(os.getpid()))
+        time.sleep(120)
+""")
+
+#: an app that says where it runs, then waits
+WAITING_APP = textwrap.dedent("""
+    import os, time
+
+    with open(os.environ["KIT_TEST_PIDFILE"], "w") as f:
+        f.write(str(os.getpid()))
+    time.sleep(120)
+""")
+
+#: a caller: a forked pytest run of test_waits.py, or a run of the waiting app
+CALLERS = {
+    "pytest run": "from conformance.discrimination import forked; import os; "
+                  "forked.run(['test_waits.py', '-q', '-p', 'no:cacheprovider'], env=dict(os.environ))",
+    "app": "from conformance.apps import launch; launch.record('waiting_app.py', ticks=1)",
+}
+
+
+def _gone(pid: int, within: float) -> bool:
+    deadline = time.monotonic() + within
+    while time.monotonic() < deadline:
+        try:
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            return True
+        time.sleep(0.1)
+    return False
+
+
+@pytest.mark.parametrize("what", sorted(CALLERS))
+def test_what_is_forked_for_a_killed_kit_ends_with_it(what, tmp_path, env):
+    """The fork server outlives the kit that started it while anything it forked runs, so what it forked
+    ends with the kit itself: a ``precision`` run stopped with ``SIGTERM`` left its pytest run going."""
+    if launch.server() is None:
+        pytest.skip("no forkserver on this platform: the kit starts a new process instead")
+    (tmp_path / "test_waits.py").write_text(WAITS, encoding="utf-8")
+    (tmp_path / "waiting_app.py").write_text(WAITING_APP, encoding="utf-8")
+    pidfile = tmp_path / "pid"
+    caller = subprocess.Popen([sys.executable, "-c", CALLERS[what]], cwd=tmp_path, env={**env, "KIT_TEST_PIDFILE": str(pidfile)},
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.monotonic() + 120
+        while not pidfile.exists() or not pidfile.read_text():
+            assert caller.poll() is None and time.monotonic() < deadline, f"the {what} never started"
+            time.sleep(0.1)
+        pid = int(pidfile.read_text())
+        caller.kill()  # SIGKILL: no handler of the kit's runs
+        caller.wait()
+        assert _gone(pid, within=10), f"the {what} (pid {pid}) still runs 10 s after the kit that asked for it was killed"
+    finally:
+        caller.kill()
+        if pidfile.exists() and pidfile.read_text():
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(int(pidfile.read_text()), signal.SIGKILL)

@@ -123,7 +123,7 @@ def _run_child(argv: list[str], env: dict, timeout: float, stderr_path: Path) ->
         command = [sys.executable, "-m", "conformance.apps.child", *argv]
         done = subprocess.run(command, capture_output=True, text=True, timeout=timeout, env=env, stdin=subprocess.DEVNULL)
         return done.returncode, done.stderr
-    process = context.Process(target=_child_main, args=(argv, env, str(stderr_path)), daemon=False)
+    process = context.Process(target=_child_main, args=(argv, env, str(stderr_path), os.getpid()), daemon=False)
     start(process)
     try:
         process.join(timeout)
@@ -158,14 +158,16 @@ def read(path: Path) -> str:
         return ""
 
 
-def _child_main(argv: list[str], env: dict, stderr_path: str) -> None:
+def _child_main(argv: list[str], env: dict, stderr_path: str, caller: int) -> None:
     """In the forked process: what ``python -m conformance.apps.child ARGV`` would do, with its output
     where :func:`_run_child` reads it (stdout nowhere, as before: only stderr is ever shown)."""
     import atexit
     import faulthandler
 
     from conformance.apps import child
+    from conformance.backends import display
 
+    display.die_with(caller)  # a kit killed mid-run leaves no app running (the server outlives it)
     quiet = os.open(os.devnull, os.O_RDWR)
     os.dup2(quiet, 0)
     os.dup2(quiet, 1)

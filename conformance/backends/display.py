@@ -49,7 +49,7 @@ __all__ = [
     "SCREEN",
     "child_environment",
     "close_x_connection",
-    "die_with_parent",
+    "die_with",
     "dies_with_this_process",
     "ensure_display",
     "on_stop",
@@ -265,11 +265,40 @@ def dies_with_this_process(*, waited_for: bool = False):
     return set_death_signal
 
 
-def die_with_parent() -> None:
-    """In a forked process: have the kernel send it ``SIGTERM`` when its parent ends (Linux; no-op elsewhere)."""
-    prctl = _prctl()
-    if prctl is not None:
-        prctl(_PR_SET_PDEATHSIG, signal.SIGTERM, 0, 0, 0)
+def die_with(pid: int) -> None:
+    """In a process forked for ``pid`` by a fork server: send this process ``SIGTERM`` when ``pid`` ends,
+    however it ends. The parent-death signal cannot say it: the parent is the fork server, which lives on
+    while any process it forked does (each holds its "alive" pipe), so a run forked for a kit that was
+    killed ran to its end, with its Xvfb (seen: ``precision`` stopped with ``SIGTERM``, its pytest run still
+    going a minute later). A daemon thread waits on a pidfd of ``pid`` (Linux 5.3+), else polls it once a
+    second; ``SIGTERM`` then takes the process's own way out (its Xvfb stopped by :func:`_on_sigterm`)."""
+    try:
+        handle = os.pidfd_open(pid)
+    except ProcessLookupError:  # gone before this process began
+        os.kill(os.getpid(), signal.SIGTERM)
+        return
+    except (AttributeError, OSError):
+        handle = None
+
+    def wait() -> None:
+        if handle is not None:
+            select.select([handle], [], [])  # readable once pid has ended
+        else:
+            while _alive(pid):
+                time.sleep(1.0)
+        os.kill(os.getpid(), signal.SIGTERM)
+
+    threading.Thread(target=wait, name=f"kit-dies-with-{pid}", daemon=True).start()
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
 
 
 # -- SIGTERM -------------------------------------------------------------------------------------

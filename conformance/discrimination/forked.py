@@ -35,7 +35,8 @@ def run(argv: list[str], *, env: dict[str, str], timeout: float | None = None) -
         return None
     with tempfile.TemporaryDirectory(prefix="kit-forked-") as tmp:
         out, err = os.path.join(tmp, "stdout"), os.path.join(tmp, "stderr")
-        process = context.Process(target=_main, args=(list(argv), dict(env), os.getcwd(), out, err), daemon=False)
+        process = context.Process(target=_main, args=(list(argv), dict(env), os.getcwd(), out, err, os.getpid()),
+                                  daemon=False)
         launch.start(process)
         try:
             process.join(timeout)
@@ -49,13 +50,13 @@ def run(argv: list[str], *, env: dict[str, str], timeout: float | None = None) -
         return subprocess.CompletedProcess(argv, process.exitcode, launch.read(Path(out)), launch.read(Path(err)))
 
 
-def _main(argv: list[str], env: dict[str, str], cwd: str, out: str, err: str) -> None:
+def _main(argv: list[str], env: dict[str, str], cwd: str, out: str, err: str, caller: int) -> None:
     """In the forked process: what ``python -m pytest ARGV`` started in ``cwd`` with ``env`` would do."""
     import atexit
 
     from conformance.backends import display
 
-    display.die_with_parent()  # the server's end (its caller's) ends this run
+    display.die_with(caller)  # the caller's end ends this run, not the server's (it outlives its caller)
     nowhere = os.open(os.devnull, os.O_RDONLY)
     os.dup2(nowhere, 0)
     os.dup2(os.open(out, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600), 1)
