@@ -16,14 +16,16 @@ the main thread in a matmul of the app judge and a run's thread in ``blas_thread
 from __future__ import annotations
 
 import os
+import shutil
 import subprocess
+import tempfile
 import threading
 from concurrent.futures import Future, ThreadPoolExecutor
 from typing import Callable
 
 from threadpoolctl import threadpool_limits
 
-__all__ = ["HOME", "OWN_SYNCS", "one_blas_thread", "result", "start_all", "stop"]
+__all__ = ["HOME", "OWN_SYNCS", "one_blas_thread", "result", "share_states", "start_all", "stop"]
 
 #: The options of a run of the kit's own syncs (``tests/*_syncs.py``): in pytest's own process, as they do
 #: not crash; a pytest-xdist worker of its own cost each run 2.5 s of CPU more (``test_discrimination``).
@@ -32,6 +34,7 @@ OWN_SYNCS = ["--conformance-isolation", "none"]
 _pool: ThreadPoolExecutor | None = None
 _futures: dict[str, Future] = {}
 _PREFIX = "kit-run"
+_states: str | None = None  # share_states' directory
 
 #: The directory the session started in, where every run of the pool starts (:func:`_started_at_home`).
 HOME = os.getcwd()
@@ -71,6 +74,18 @@ def _executor() -> ThreadPoolExecutor:
     return _pool
 
 
+def share_states() -> None:
+    """One directory for the whole session where every process replays each scene's golden physics once
+    (``conformance.rendering.snapshots.SHARED_STATES``, inherited by the runs): each right sync's run, the
+    random draws' and the README example's stepped the same three wall scenes again (3.1 s of CPU a run)."""
+    global _states
+    from conformance.rendering import snapshots
+
+    if _states is None and not os.environ.get(snapshots.SHARED_STATES):
+        _states = tempfile.mkdtemp(prefix="kit-states-")
+        os.environ[snapshots.SHARED_STATES] = _states
+
+
 def start_all(runs: dict[str, tuple[float, Callable[[], object]]]) -> None:
     """Start every run not started yet, highest priority (longest) first."""
     for key, (_, call) in sorted(runs.items(), key=lambda kv: -kv[1][0]):
@@ -94,3 +109,10 @@ def stop() -> None:
         _pool.shutdown(wait=True)
     _pool = None
     _futures.clear()
+    global _states
+    if _states is not None:
+        from conformance.rendering import snapshots
+
+        os.environ.pop(snapshots.SHARED_STATES, None)
+        shutil.rmtree(_states, ignore_errors=True)
+        _states = None

@@ -62,6 +62,7 @@ def pytest_runtestloop(session):
         from conformance.apps import launch
 
         launch.start_server()
+        background.share_states()
     background.start_all(runs)
 
 

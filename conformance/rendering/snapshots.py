@@ -20,13 +20,14 @@
 from __future__ import annotations
 
 import functools
+import json
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from conformance import backends
+from conformance import backends, files
 from conformance.bullet import state
 from conformance.errors import GoldenError, GoldenFramesBadly
 from conformance.rendering import framing
@@ -143,9 +144,16 @@ def check_physics(scene_name: str, goldens: dict[int, storage.Golden]) -> list[P
 def live_states(scene_name: str, frames: tuple[int, ...]) -> dict[int, dict[str, Any]]:
     """The bare scene's physics state (default parameters) at ``frames``, stepped once per process:
     both golden verdicts of every sync run need it, and a scene steps the same way every time
-    (``test_is_deterministic_in_process``)."""
+    (``test_is_deterministic_in_process``). With :data:`SHARED_STATES` naming a directory, once for
+    all the processes that share it (:func:`_shared_file`)."""
     from conformance import scenes
 
+    shared = _shared_file(scene_name, frames)
+    if shared is not None:
+        try:
+            return {int(frame): s for frame, s in json.loads(shared.read_bytes())["states"].items()}
+        except (OSError, ValueError, KeyError, TypeError, AttributeError):  # none yet, or not whole: step it
+            pass
     states = {}
     with scenes.build(scene_name) as scene:
         done = 0
@@ -154,7 +162,43 @@ def live_states(scene_name: str, frames: tuple[int, ...]) -> dict[int, dict[str,
                 scene.advance(step)
             done = frame
             states[frame] = state.capture(scene)
+    if shared is not None:
+        try:
+            files.write_atomically(shared, json.dumps({"scene": scene_name, "states": states}).encode("utf-8"))
+        except OSError:  # not shared, then: this process has the states all the same
+            pass
     return states
+
+
+#: The environment variable naming a directory where the processes of one session share :func:`live_states`
+#: (the kit's own test session sets it for its sync runs: each right sync's run stepped the three wall
+#: scenes, 3.1 s of CPU, to replay the same physics; ``tests/background.py``).
+SHARED_STATES = "CONFORMANCE_SHARED_STATES"
+
+
+def _shared_file(scene_name: str, frames: tuple[int, ...]) -> Path | None:
+    """Where the states of ``scene_name`` at ``frames`` are shared, named by everything they follow from:
+    the scene (its module's source, parameters, gravity), the code that steps and captures a scene, and
+    pyBullet's version; None unless :data:`SHARED_STATES` is set. Floats go through JSON exactly (repr)."""
+    import hashlib
+    import importlib.metadata
+    import inspect
+    import os
+
+    from conformance import scenes
+    from conformance.scenes import base
+
+    directory = os.environ.get(SHARED_STATES)
+    if not directory:
+        return None
+    spec = scenes.get(scene_name)
+    digest = hashlib.sha256(json.dumps([scene_name, list(frames), repr(sorted(spec.defaults.items())), list(spec.gravity),
+                                        importlib.metadata.version("pybullet")]).encode("utf-8"))
+    for source in (inspect.getsourcefile(spec.populate), base.__file__, state.__file__):
+        if source is None:  # a scene whose code has no file: nothing to name it by, so not shared
+            return None
+        digest.update(Path(source).read_bytes())
+    return Path(directory) / f"{scene_name}-{digest.hexdigest()[:24]}.json"
 
 
 @dataclass(frozen=True)
