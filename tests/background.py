@@ -102,14 +102,13 @@ def result(key: str, call: Callable[[], object]):
 
 def stop() -> None:
     """Cancel what has not started; wait for what has (their processes end on their own)."""
-    global _pool
+    global _pool, _states
     for future in _futures.values():
         future.cancel()
     if _pool is not None:
         _pool.shutdown(wait=True)
     _pool = None
     _futures.clear()
-    global _states
     if _states is not None:
         from conformance.rendering import snapshots
 

@@ -20,7 +20,11 @@
 from __future__ import annotations
 
 import functools
+import hashlib
+import importlib.metadata
+import inspect
 import json
+import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -180,11 +184,6 @@ def _shared_file(scene_name: str, frames: tuple[int, ...]) -> Path | None:
     """Where the states of ``scene_name`` at ``frames`` are shared, named by everything they follow from:
     the scene (its module's source, parameters, gravity), the code that steps and captures a scene, and
     pyBullet's version; None unless :data:`SHARED_STATES` is set. Floats go through JSON exactly (repr)."""
-    import hashlib
-    import importlib.metadata
-    import inspect
-    import os
-
     from conformance import scenes
     from conformance.scenes import base
 
