@@ -35,6 +35,8 @@ def _silhouettes(run, kit):
     if run.frame not in scenes.get(run.scene.name).frames_with_goldens():
         return
     scene = run.scene
+    if not silhouettes.pybullet_draws_it(scene, run.frame):
+        return  # frame 0 of a scene with a soft body: the vertex checks judge it
     ids_fury = backends.render_ids(run.drawing, scene.camera, scene.image_size)
     ids_bullet = silhouettes.pybullet_mask(scene, scene.bindings, scene.camera, scene.image_size)
     record = silhouettes.silhouette_record(run, kit.sync, ids_fury, ids_bullet, f"test_silhouettes_match_pybullet_at_golden_frames[{scene.name}]",

@@ -123,7 +123,7 @@ def machine(kit: Kit, scene_name: str) -> type[RuleBasedStateMachine]:
         def start(self, params):
             self._context = checker.run(scene_name, **params)
             self.run = self._context.__enter__()  # built, and synced at frame 0
-            self.bodies = sorted({b.body for b in self.run.scene.bindings})
+            self.bodies = sorted({b.body for b in self.run.scene.rigid})
             self.built_mass = {b: self.run.scene.p.getDynamicsInfo(b, -1)[0] for b in self.bodies}
             self.calls.append("start() [built, frame 0 synced]")
             self.fresh = True

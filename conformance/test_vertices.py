@@ -44,7 +44,7 @@ def check_run(kit, scene_name: str, params: dict, frames: int, events=()) -> Non
 def turned_everything(scene_name: str, params: dict, turns) -> list:
     """:func:`conformance.bullet.events.turning_everything` for every body of the scene built with ``params``."""
     with scenes.build(scene_name, **params) as probe:
-        bodies = len({b.body for b in probe.bindings})
+        bodies = len({b.body for b in probe.rigid})
     return turning_everything(bodies, turns)
 
 

@@ -30,6 +30,12 @@ class Target:
     ``brick_centers``/``brick_orns``). The link frame is what ``getLinkState(...)[4:6]`` reports for
     a link and what ``createMultiBody(basePosition=…)`` sets for a base; for the kit's scenes the base
     link frame is also the centre of mass that ``getBasePositionAndOrientation`` reports.
+
+    ``nodes`` is None for a rigid body or link. For a soft body (``loadSoftBody``) it is the simulated
+    node each vertex follows: vertex ``start + k`` is drawn at node ``nodes[k]`` of
+    ``getMeshData(body, -1, flags=MESH_DATA_SIMULATION_MESH)[1]``, in world coordinates. A soft body
+    has no pose to draw it by: its actor keeps the identity transform (``position``/``orientation``
+    are the identity) and a sync copies the nodes into the vertices after each step.
     """
 
     name: str
@@ -41,6 +47,7 @@ class Target:
     shared: bool
     position: np.ndarray
     orientation: np.ndarray
+    nodes: np.ndarray | None = None
 
 
 @dataclass(frozen=True, eq=False)

@@ -25,6 +25,7 @@ __all__ = [
     "MovingPivot",
     "Scene",
     "Shape",
+    "Surface",
     "IDENTITY",
 ]
 
@@ -68,6 +69,41 @@ class Shape:
 
 
 @dataclass(frozen=True)
+class Surface:
+    """How a soft body is drawn: triangles over its simulated nodes, one vertex per node in pyBullet's
+    node order (``getMeshData(body, -1, flags=MESH_DATA_SIMULATION_MESH)``), flat shaded.
+
+    ``faces`` index the nodes, as the OBJ file the body was loaded from does (:meth:`Scene.add_soft_body`
+    checks that pyBullet kept that file's vertices as its nodes, in order)."""
+
+    faces: tuple[tuple[int, int, int], ...]
+    color: tuple[float, float, float] = (0.8, 0.8, 0.8)
+    kind = "surface"
+
+    def __post_init__(self):
+        if not self.faces or any(len(f) != 3 or min(f) < 0 for f in self.faces):
+            raise InvalidArgument(f"faces={self.faces!r}, but should be triangles of node indices (three integers >= 0 each)")
+
+
+def obj_mesh(path: str) -> tuple[np.ndarray, tuple[tuple[int, int, int], ...]]:
+    """The vertices ``(n, 3)`` and triangles of a Wavefront OBJ file, polygons split into fans, indices
+    from 0: the mesh a soft body loaded from that file simulates (pyBullet keeps its vertices as nodes)."""
+    vertices, faces = [], []
+    with open(path) as f:
+        for line in f:
+            words = line.split()
+            if not words:
+                continue
+            if words[0] == "v":
+                vertices.append([float(w) for w in words[1:4]])
+            elif words[0] == "f":
+                corners = [int(w.split("/")[0]) for w in words[1:]]
+                corners = [c - 1 if c > 0 else len(vertices) + c for c in corners]
+                faces.extend((corners[0], corners[k], corners[k + 1]) for k in range(1, len(corners) - 1))
+    return np.asarray(vertices, dtype=np.float64).reshape(-1, 3), tuple(faces)
+
+
+@dataclass(frozen=True)
 class Binding:
     """One drawn thing: body ``body`` (link ``link``, -1 for the base) is drawn by actor ``actor``.
 
@@ -80,7 +116,12 @@ class Binding:
     body: int
     link: int
     actor: str
-    shape: Shape
+    shape: Shape | Surface
+
+    @property
+    def soft(self) -> bool:
+        """A soft body, drawn by its nodes (:class:`Surface`), not a rigid link."""
+        return isinstance(self.shape, Surface)
 
 
 @dataclass(frozen=True)
@@ -161,7 +202,9 @@ class MovingPivot:
 class Scene:
     """A reference scene: a live pybullet DIRECT client and what to draw.
 
-    Create it with a scene builder (``scenes.build(name, **params)``); the constructor only connects.
+    Create it with a scene builder (``scenes.build(name, **params)``); the constructor only connects
+    (and, for a ``deformable`` scene, resets the world with ``RESET_USE_DEFORMABLE_WORLD``, which soft
+    bodies need and which must come before anything else is set).
     """
 
     name: str
@@ -173,6 +216,7 @@ class Scene:
     description: str = ""
     bindings: list[Binding] = field(default_factory=list)
     actions: list[Any] = field(default_factory=list)
+    deformable: bool = False
     client: int = field(init=False, default=-1)
 
     def __post_init__(self):
@@ -180,6 +224,8 @@ class Scene:
         if self.client < 0:
             raise SceneError(f"scene {self.name!r}: pybullet.connect(DIRECT) failed (returned {self.client})")
         self.p = BoundClient(self.client)
+        if self.deformable:
+            self.p.resetSimulation(pybullet.RESET_USE_DEFORMABLE_WORLD)
         self.p.setTimeStep(self.dt)
 
     # -- building -------------------------------------------------------------------------------
@@ -221,7 +267,26 @@ class Scene:
         self.bind(name, body, -1, shape, actor=actor)
         return body
 
-    def bind(self, name: str, body: int, link: int, shape: Shape, *, actor: str | None = None) -> Binding:
+    def add_soft_body(self, name: str, path: str, *, position: Sequence[float], color: tuple[float, float, float],
+                      scale: float = 1.0, anchors: Sequence[int] = (), **soft: Any) -> int:
+        """Load the OBJ mesh at ``path`` as a soft body (``loadSoftBody(path, basePosition=position,
+        scale=scale, **soft)``), pin ``anchors`` (node indices) to the world (``createSoftBodyAnchor``),
+        and bind it for drawing as a :class:`Surface` of the file's triangles. Needs a ``deformable`` scene."""
+        if not self.deformable:
+            raise SceneError(f"scene {self.name!r}: a soft body needs a deformable world (SceneSpec(deformable=True))")
+        body = self.p.loadSoftBody(path, basePosition=list(position), scale=scale, **soft)
+        vertices, faces = obj_mesh(path)
+        nodes = np.asarray(self.p.getMeshData(body, -1, flags=pybullet.MESH_DATA_SIMULATION_MESH)[1], dtype=np.float64)
+        if nodes.shape != vertices.shape or not np.allclose(nodes, vertices * scale + np.asarray(position), atol=1e-6):
+            # the faces index the file's vertices: they draw the body only if pyBullet kept those as its nodes
+            raise SceneError(f"scene {self.name!r}: soft body {name!r} from {path} has {len(nodes)} nodes that are not the "
+                             f"file's {len(vertices)} vertices in order, so the file's faces cannot draw it")
+        for node in anchors:
+            self.p.createSoftBodyAnchor(body, int(node), -1, -1)
+        self.bind(name, body, -1, Surface(faces=faces, color=color))
+        return body
+
+    def bind(self, name: str, body: int, link: int, shape: Shape | Surface, *, actor: str | None = None) -> Binding:
         binding = Binding(name=name, body=body, link=link, actor=actor or name, shape=shape)
         self.bindings.append(binding)
         return binding
@@ -243,6 +308,11 @@ class Scene:
             self.advance(step)
             if on_step is not None:
                 on_step(step + 1)
+
+    @property
+    def rigid(self) -> list[Binding]:
+        """The bindings of rigid bodies and links (every binding but soft bodies')."""
+        return [b for b in self.bindings if not b.soft]
 
     def poses(self) -> np.ndarray:
         """Centre-of-mass pose of every binding, ``(n, 7)`` float64 = position + quaternion (x, y, z, w)."""
@@ -271,8 +341,14 @@ class Scene:
         engine parameters, as bytes: equal bytes mean pybullet holds exactly the same state."""
         p = self.p
         parts = [repr(sorted(p.getPhysicsEngineParameters().items()))]
+        soft = {b.body for b in self.bindings if b.soft}
         for i in range(p.getNumBodies()):
             body = p.getBodyUniqueId(i)
+            if body in soft:
+                # its nodes are its state; getDynamicsInfo of a soft body reports uninitialised memory (measured:
+                # denormals that change from call to call), which would make every sync look like it touched it
+                parts.append(repr((body, p.getMeshData(body, -1, flags=pybullet.MESH_DATA_SIMULATION_MESH)[1])))
+                continue
             parts.append(repr((body, p.getBasePositionAndOrientation(body), p.getBaseVelocity(body),
                                p.getDynamicsInfo(body, -1))))
             joints = list(range(p.getNumJoints(body)))

@@ -29,6 +29,8 @@ _MODULES = (
     "weighted",
     "tumbling",
     "crossing",
+    "cloth",
+    "soft_ball",
 )
 
 
@@ -68,6 +70,8 @@ class SceneSpec:
     #: grouped into actors, never a body or its pose: its reference picture must be the default's
     #: within the same-renderer tolerance (``tests/test_golden_variants.py`` keeps that true).
     golden_variants: tuple[Mapping[str, Any], ...] = ()
+    #: The world is reset with ``RESET_USE_DEFORMABLE_WORLD`` before anything is built: soft bodies need it.
+    deformable: bool = False
     defaults: Mapping[str, Any] = field(init=False)
 
     def __post_init__(self):
@@ -102,6 +106,7 @@ class SceneSpec:
             image_size=self.image_size,
             steps=self.steps,
             description=self.description,
+            deformable=self.deformable,
         )
         try:
             scene.p.setGravity(*self.gravity)

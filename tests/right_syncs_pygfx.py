@@ -7,7 +7,9 @@ world pose of every target's *link frame* (a base: the centre-of-mass pose from
 moves whole actors and the vertex ranges of shared actors there, turns stored vertex normals with
 them (``geometry.normals``, which FURY 2's smooth spheres have), and announces what it wrote with
 the buffer's ``update_range``/``update_full`` so that pygfx uploads it (without, the GPU keeps the old
-vertices).
+vertices). A soft body (``Target.nodes``) has no pose: each copies its simulated nodes
+(``getMeshData(..., flags=MESH_DATA_SIMULATION_MESH)``) into its actor's positions, each in its own
+way, and leaves the actor's ``local`` transform the identity.
 
 This file holds what touches a FURY 2 actor; each class's renderer-free steps (poses, link-frame
 geometry, the arithmetic of a range rewrite) are its base in ``sync_steps``, shared with the FURY 0.12
@@ -73,7 +75,12 @@ class UserMatrixSync(_Arrays, sync_steps.UserMatrixSteps):
     for shared actors, each range announced with ``update_range``."""
 
     def __call__(self):
+        read = {}
         for t in self.targets:
+            if t.nodes is not None:
+                self.copy_nodes(t, read)
+                self.announce_range(t)
+                continue
             pos, orn = self.pose(t)
             if t.shared:
                 self.move_range(t, pos, orn)
@@ -92,7 +99,10 @@ class IncrementalSync(_Arrays, sync_steps.IncrementalSteps):
 
     def __call__(self):
         for t in self.targets:
-            if t.shared:
+            if t.nodes is not None:
+                self.refresh_nodes(t)
+                self.announce_range(t)
+            elif t.shared:
                 self.turn_range(t)
                 self.announce_range(t)
             else:

@@ -5,7 +5,9 @@ world pose of every target's *link frame* (a base: the centre-of-mass pose from
 ``getBasePositionAndOrientation`` composed with the inverse of the base's local inertial frame,
 ``getDynamicsInfo(body, -1)[3:5]``; a link: ``getLinkState(..., computeForwardKinematics=1)[4:6]``),
 moves whole actors and the vertex ranges of shared actors there, turns stored vertex normals with
-them, and marks what it wrote as modified so that VTK draws it.
+them, and marks what it wrote as modified so that VTK draws it. A soft body (``Target.nodes``) has no
+pose: each copies its simulated nodes (``getMeshData(..., flags=MESH_DATA_SIMULATION_MESH)``) into its
+actor's vertices, each in its own way, and leaves the actor's transform the identity.
 
 This file holds what touches a FURY 0.12 actor; each class's renderer-free steps (poses, link-frame
 geometry, the arithmetic of a range rewrite) are its base in ``sync_steps``, shared with the FURY 2
@@ -85,8 +87,12 @@ class UserMatrixSync(_Arrays, sync_steps.UserMatrixSteps):
     """Right: per-actor user matrices; per-target vertex rewrite (and normals) for shared actors."""
 
     def __call__(self):
-        touched = {}
+        touched, read = {}, {}
         for t in self.targets:
+            if t.nodes is not None:
+                self.copy_nodes(t, read)
+                touched[id(t.actor)] = t.actor
+                continue
             pos, orn = self.pose(t)
             if t.shared:
                 self.move_range(t, pos, orn)
@@ -108,7 +114,10 @@ class IncrementalSync(_Arrays, sync_steps.IncrementalSteps):
     def __call__(self):
         touched = {}
         for t in self.targets:
-            if t.shared:
+            if t.nodes is not None:
+                self.refresh_nodes(t)
+                touched[id(t.actor)] = t.actor
+            elif t.shared:
                 self.turn_range(t)
                 touched[id(t.actor)] = t.actor
             else:

@@ -8,7 +8,9 @@ one, announcing a changed range) is in those files and in ``wrong_syncs_<backend
 * pose helpers: :func:`link_frame` (scipy), :func:`link_frame_offsets` (each base's inverse inertial
   frame, scipy) and :func:`inverse_inertial_frames` (the same with pybullet's ``invertTransform``),
   :func:`link_frame_geometry` (a shared target's vertex range in its link frame), :func:`pose_matrix`,
-  :func:`euler_angles`;
+  :func:`euler_angles`; all for rigid targets only: a soft body's target (``Target.nodes`` not None)
+  has no pose (``getDynamicsInfo`` of a soft body reports garbage), each sync copies its nodes
+  (:func:`soft_nodes`, pyBullet's simulated mesh) into its vertices in its own way;
 * the right syncs' steps, under each backend's class of the same name without ``Steps``:
   :class:`PerTargetSteps`, :class:`UserMatrixSteps`, :class:`IncrementalSteps`,
   :class:`PositionOrientationSteps`, and :func:`vectorised_vertex_sync`, the closure itself;
@@ -45,6 +47,7 @@ __all__ = [
     "link_frame_geometry",
     "link_frame_offsets",
     "pose_matrix",
+    "soft_nodes",
     "vectorised_vertex_sync",
 ]
 
@@ -52,12 +55,19 @@ __all__ = [
 # ---- poses ---------------------------------------------------------------------------------------------
 
 def _bases(targets) -> list[int]:
-    """The bodies whose base is a target, in the order they first appear."""
-    return list(dict.fromkeys(t.body for t in targets if t.link == -1))
+    """The rigid bodies whose base is a target, in the order they first appear (a soft body has no
+    inertial frame to undo: ``getDynamicsInfo`` reports garbage for it)."""
+    return list(dict.fromkeys(t.body for t in targets if t.link == -1 and t.nodes is None))
+
+
+def soft_nodes(p, body: int):
+    """A soft body's simulated nodes now, in world coordinates, as pyBullet returns them (a tuple of
+    (x, y, z)); without the flag ``getMeshData`` gives the visual mesh, which need not be the nodes."""
+    return p.getMeshData(body, -1, flags=p.MESH_DATA_SIMULATION_MESH)[1]
 
 
 def link_frame(p, body: int, link: int):
-    """Link-frame world pose as (position, scipy Rotation)."""
+    """Link-frame world pose as (position, scipy Rotation), of a rigid body's base or link."""
     if link >= 0:
         state = p.getLinkState(body, link, computeForwardKinematics=1)
         return np.asarray(state[4], dtype=np.float64), Rotation.from_quat(state[5])
@@ -156,7 +166,10 @@ class PerTargetSteps(ActorArrays):
 
     # -- the steps a mistake can hide in ---------------------------------------------------------
     def link_pose(self, t):
-        """World pose (position, x-y-z-w quaternion) of the target's link frame."""
+        """World pose (position, x-y-z-w quaternion) of the target's link frame; a soft body's is the
+        world's (its nodes are world coordinates, its actor keeps the identity)."""
+        if t.nodes is not None:
+            return (0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0)
         if t.link >= 0:
             return self.p.getLinkState(t.body, t.link, computeForwardKinematics=1)[4:6]
         com_pos, com_orn = self.p.getBasePositionAndOrientation(t.body)
@@ -184,15 +197,22 @@ class PerTargetSteps(ActorArrays):
         if t.name in self.local_normals:
             self.normal_view(t.actor)[t.start:t.stop] = self.local_normals[t.name] @ rotation.T
 
+    def place_soft(self, t) -> None:
+        """Copy a soft target's nodes, read for it alone, into its vertices (they have no pose to place)."""
+        self.vertex_view(t.actor)[t.start:t.stop] = np.asarray(soft_nodes(self.p, t.body))[t.nodes]
+
     def finish(self, actors) -> None:
-        """Announce the vertices (and normals) written into these shared actors (the backend's)."""
+        """Announce the vertices (and normals) written into these shared and soft actors (the backend's)."""
         raise NotImplementedError
 
     def draw(self, posed) -> None:
-        """Place each ``(target, position, orientation)`` and finish the shared actors written."""
+        """Place each ``(target, position, orientation)`` and finish the shared and soft actors written."""
         touched = {}
         for t, pos, orn in posed:
-            if t.shared:
+            if t.nodes is not None:
+                self.place_soft(t)
+                touched[id(t.actor)] = t.actor
+            elif t.shared:
                 self.place_shared(t, pos, orn)
                 touched[id(t.actor)] = t.actor
             else:
@@ -214,6 +234,13 @@ class UserMatrixSteps(ActorArrays):
         self.geometry = {  # target name -> (link-frame vertices, link-frame normals or None)
             t.name: link_frame_geometry(t, self.vertex_view(t.actor), self.normal_view(t.actor))
             for t in self.targets if t.shared}
+
+    def copy_nodes(self, t, read: dict) -> None:
+        """Write a soft target's nodes into its vertices, each body's nodes read once a frame into ``read``
+        (body -> float64 array) however many targets follow them."""
+        if t.body not in read:
+            read[t.body] = np.array(soft_nodes(self.p, t.body), dtype=np.float64)
+        self.vertex_view(t.actor)[t.start:t.stop] = np.take(read[t.body], t.nodes, axis=0)
 
     def pose(self, t):
         if t.link >= 0:
@@ -250,6 +277,8 @@ class IncrementalSteps(ActorArrays):
         self.normals = {}
         self.matrices = {}  # target name -> 4x4 float64 matrix of a whole actor
         for t in self.targets:
+            if t.nodes is not None:
+                continue  # a soft body: nothing to turn (refresh_nodes)
             self.last[t.name] = (np.array(t.position, dtype=np.float64), Rotation.from_quat(t.orientation))
             if t.shared and id(t.actor) not in self.vertices:
                 self.vertices[id(t.actor)] = np.array(self.vertex_view(t.actor), dtype=np.float64)
@@ -277,6 +306,11 @@ class IncrementalSteps(ActorArrays):
             normals[t.start:t.stop] = normals[t.start:t.stop] @ delta.T
             self.normal_view(t.actor)[t.start:t.stop] = normals[t.start:t.stop]
 
+    def refresh_nodes(self, t) -> None:
+        """A soft target's vertices, copied fresh from its nodes: a soft body does not move by one turn
+        and shift, so there is no motion since the last frame to apply, and nothing to pile up."""
+        self.vertex_view(t.actor)[t.start:t.stop] = np.asarray(soft_nodes(self.p, t.body), dtype=np.float64)[t.nodes]
+
     def turn_whole(self, t) -> np.ndarray:
         """A whole actor's 4x4 float64 matrix turned and moved by its motion."""
         pos, old_pos, delta = self.motion(t)
@@ -293,8 +327,9 @@ class PositionOrientationSteps(ActorArrays):
 
     def __init__(self, world):
         self.p = world.p
-        self.whole = [t for t in world.targets if not t.shared]
+        self.whole = [t for t in world.targets if not t.shared and t.nodes is None]
         self.shared = [t for t in world.targets if t.shared]
+        self.soft = [t for t in world.targets if t.nodes is not None]
         self.local = {}
         for t in self.shared:
             back = np.reshape(self.p.getMatrixFromQuaternion(list(t.orientation)), (3, 3)).T
@@ -325,17 +360,28 @@ class PositionOrientationSteps(ActorArrays):
                 for k, normal in enumerate(normals):
                     stored[t.start + k] = matrix @ normal
             touched[id(t.actor)] = t.actor
+        for t in self.soft:  # no pose: each vertex is its node, copied row by row
+            nodes = soft_nodes(self.p, t.body)
+            vertices = self.vertex_view(t.actor)
+            for k, node in enumerate(t.nodes):
+                vertices[t.start + k] = nodes[node]
+            touched[id(t.actor)] = t.actor
         for actor in touched.values():
             self.announce(actor)
 
 
 def vectorised_vertex_sync(world, arrays: type[ActorArrays]):
     """``right_syncs``' closure that rewrites every actor's vertices (whole actors too) with one einsum
-    per actor, reaching them through the backend's ``arrays``."""
+    per actor, reaching them through the backend's ``arrays``; a soft body's actor with one gather of
+    its nodes, read once a frame per body."""
     p = world.p
     groups = defaultdict(list)
+    soft = defaultdict(list)  # soft body -> (actor, vertex range, nodes) of each target following its nodes
     for i, t in enumerate(world.targets):
-        groups[id(t.actor)].append(i)
+        if t.nodes is None:
+            groups[id(t.actor)].append(i)
+        else:
+            soft[t.body].append((t.actor, slice(t.start, t.stop), t.nodes))
     plan = []
     for members in groups.values():
         actor = world.targets[members[0]].actor
@@ -351,11 +397,19 @@ def vectorised_vertex_sync(world, arrays: type[ActorArrays]):
             local_normals = np.einsum("nij,nkj->nki", drawn, np.stack([normals[a:b] for a, b in ranges]))
         plan.append((actor, members, ranges, local, local_normals))
     bodies = [(t.body, t.link) for t in world.targets]
+    rigid = [i for i, t in enumerate(world.targets) if t.nodes is None]
 
     def sync():
-        frames = [link_frame(p, body, link) for body, link in bodies]
-        positions = np.array([f[0] for f in frames])
-        matrices = Rotation.concatenate([f[1] for f in frames]).as_matrix()
+        positions, matrices = np.zeros((len(bodies), 3)), np.zeros((len(bodies), 3, 3))  # soft targets' rows unused
+        if rigid:
+            frames = [link_frame(p, *bodies[i]) for i in rigid]
+            positions[rigid] = [f[0] for f in frames]
+            matrices[rigid] = Rotation.concatenate([f[1] for f in frames]).as_matrix()
+        for body, copies in soft.items():
+            nodes = np.asarray(soft_nodes(p, body), dtype=np.float64)
+            for actor, rows, follows in copies:
+                arrays.vertex_view(actor)[rows] = nodes[follows]  # one gather a target
+                arrays.announce(actor)
         for actor, members, ranges, local, local_normals in plan:
             moved = np.einsum("nij,nkj->nki", matrices[members], local) + positions[members][:, None, :]
             vertices = arrays.vertex_view(actor)

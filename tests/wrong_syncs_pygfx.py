@@ -68,6 +68,10 @@ class CentreNotUpdated(sync_steps.StaleCentre, Baseline):
         super().place_shared(t, pos, orn)
         t.actor.geometry.positions.update_range(t.start, t.stop - t.start)
 
+    def place_soft(self, t):
+        super().place_soft(t)
+        self.announce_range(t)  # so that a soft body's nodes are announced too: the mistake is the centre alone
+
     def finish(self, actors):
         pass  # each range was announced as it was written
 
@@ -117,6 +121,10 @@ class AnnouncesLastRangeOnly(Baseline):
     def place_shared(self, t, pos, orn):
         super().place_shared(t, pos, orn)
         self.last = t
+
+    def place_soft(self, t):
+        super().place_soft(t)
+        self.announce_range(t)  # a soft body's actor is its own: its one range is the last (the mistake is in shared ones)
 
     def finish(self, actors):
         last = getattr(self, "last", None)

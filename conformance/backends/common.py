@@ -46,7 +46,8 @@ class Drawing:
 
 
 def lay_out(scene, make_actor: Callable[[str, np.ndarray, np.ndarray, np.ndarray], Any], points: Callable[[Any], np.ndarray],
-            normals: Callable[[Any], np.ndarray | None], announce: Callable[[Any], None]) -> Drawing:
+            normals: Callable[[Any], np.ndarray | None], announce: Callable[[Any], None], *,
+            make_surface: Callable[[np.ndarray, np.ndarray, np.ndarray], Any]) -> Drawing:
     """Actors for every binding of ``scene``, drawn at the poses pybullet holds now.
 
     ``make_actor(kind, centers, colors, sizes)`` makes one actor drawing shapes of one kind at the
@@ -57,17 +58,27 @@ def lay_out(scene, make_actor: Callable[[str, np.ndarray, np.ndarray, np.ndarray
     Whole actors are built at the origin with an identity transform (the guide: "Centers for the
     actor must be set to (0, 0, 0)"); shared actors have each vertex range written at its body's
     current link-frame pose (as the guide's single-actor example builds them from ``brick_centers``).
+
+    A soft body (a :class:`~conformance.scenes.base.Surface` binding) is an actor of its own made by
+    ``make_surface(vertices, faces, colors)``: one vertex per simulated node, at the nodes' positions now,
+    its triangles as the scene gives them, no stored normals (flat shaded, so no normal goes stale).
     """
     groups: dict[str, list[int]] = defaultdict(list)
     for i, binding in enumerate(scene.bindings):
         groups[binding.actor].append(i)
-    positions, orientations = truth.link_frames(scene.p, [(b.body, b.link) for b in scene.bindings])
+    positions, orientations = truth.link_frames(scene.p, truth.items_of(scene.bindings))
 
     actors: dict[str, Any] = {}
     targets: list[Target | None] = [None] * len(scene.bindings)
     local: list[np.ndarray | None] = [None] * len(scene.bindings)
     local_normals: list[np.ndarray | None] = [None] * len(scene.bindings)
     for name, members in groups.items():
+        if any(scene.bindings[i].soft for i in members):
+            if len(members) != 1:
+                raise SceneError(f"scene {scene.name!r}: actor {name!r} would draw a soft body with other bodies")
+            i = members[0]
+            actors[name], targets[i], local[i] = _soft_actor(scene, scene.bindings[i], make_surface, announce)
+            continue
         shapes = [scene.bindings[i].shape for i in members]
         kinds = {s.kind for s in shapes}
         if len(kinds) != 1:
@@ -103,6 +114,18 @@ def lay_out(scene, make_actor: Callable[[str, np.ndarray, np.ndarray, np.ndarray
 
     world = World(scene=scene.name, p=scene.p, targets=tuple(targets), actors=actors)
     return Drawing(world=world, local=tuple(local), local_normals=tuple(local_normals))
+
+
+def _soft_actor(scene, binding, make_surface, announce) -> tuple[Any, Target, np.ndarray]:
+    """The actor, target and world geometry of one soft body: a surface through its nodes as they are now."""
+    nodes = truth.nodes(scene.p, binding.body)
+    faces = np.asarray(binding.shape.faces, dtype=np.int64)
+    # a copy: FURY may keep the array it is given as the actor's vertices, which the sync then rewrites
+    actor = make_surface(nodes.copy(), faces, np.tile(np.asarray(binding.shape.color, dtype=np.float64), (len(nodes), 1)))
+    announce(actor)
+    target = Target(name=binding.name, body=binding.body, link=-1, actor=actor, start=0, stop=len(nodes), shared=False,
+                    position=IDENTITY_POSITION.copy(), orientation=IDENTITY_ORIENTATION.copy(), nodes=np.arange(len(nodes)))
+    return actor, target, nodes
 
 
 @contextlib.contextmanager

@@ -73,6 +73,13 @@ def _fury_actor(kind: str, centers: np.ndarray, colors: np.ndarray, sizes: np.nd
     return made
 
 
+def _fury_surface(vertices: np.ndarray, faces: np.ndarray, colors: np.ndarray):
+    """A FURY 2 surface through ``vertices`` (a soft body's nodes), its triangles ``faces``, flat shaded."""
+    from fury import actor as fury_actor
+
+    return fury_actor.surface(vertices.astype(np.float32), faces.astype(np.int32), colors=colors.astype(np.float32))
+
+
 def _points(actor) -> np.ndarray:
     return actor.geometry.positions.data
 
@@ -94,7 +101,7 @@ def build(scene) -> Drawing:
 
     A tiny first draw puts them there, as a window's first frame does: until then every buffer waits
     for a full upload, and any change made meanwhile would reach the GPU announced or not."""
-    drawing = lay_out(scene, _fury_actor, _points, _normals, _announce)
+    drawing = lay_out(scene, _fury_actor, _points, _normals, _announce, make_surface=_fury_surface)
     _first_draw(drawing)
     return drawing
 

@@ -41,6 +41,13 @@ def _fury_actor(kind: str, centers: np.ndarray, colors: np.ndarray, sizes: np.nd
                                radius=float(ratios[0]), heights=sizes[:, 1], capped=True, resolution=16)
 
 
+def _fury_surface(vertices: np.ndarray, faces: np.ndarray, colors: np.ndarray):
+    """A FURY 0.12 surface through ``vertices`` (a soft body's nodes), its triangles ``faces``."""
+    from fury import actor as fury_actor
+
+    return fury_actor.surface(vertices, faces=faces, colors=colors)
+
+
 #: Per actor, the Python wrappers of what the checks walk to every frame (mapper, polydata, points, point data,
 #: normals, matrix), kept alive and never read: VTK makes a new wrapper for a C++ object that no Python
 #: reference holds, 2 µs a call, and the walk from an actor to its points cost a brick wall's frame 0.6 ms
@@ -85,7 +92,7 @@ def _announce(actor) -> None:
 def build(scene) -> Drawing:
     """Actors for every binding of ``scene``, drawn at the poses pybullet holds now
     (:func:`conformance.backends.common.lay_out`), as FURY 0.12 actors."""
-    return lay_out(scene, _fury_actor, _points, _normals, _announce)
+    return lay_out(scene, _fury_actor, _points, _normals, _announce, make_surface=_fury_surface)
 
 
 def flush(drawing: Drawing) -> None:

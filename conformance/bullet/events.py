@@ -20,7 +20,8 @@ __all__ = ["LIFT", "Event", "JointReset", "Kick", "Teleport", "dumps", "loads", 
 
 
 def _bodies(scene) -> list[int]:
-    return sorted({b.body for b in scene.bindings})
+    """The rigid bodies events act on: a soft body has no one pose to teleport or velocity to kick."""
+    return sorted({b.body for b in scene.bindings if not b.soft})
 
 
 def _joints(scene) -> list[tuple[int, int]]:

@@ -52,8 +52,9 @@ NOISE_STEP = 1.0 / 240.0
 
 
 def capture(scene) -> dict[str, Any]:
-    """Every body's base pose, velocity and joint states, and every target's link-frame pose."""
+    """Every body's base pose, velocity and joint states (a soft body's nodes), and every target's link-frame pose."""
     p = scene.p
+    soft = {b.body for b in scene.bindings if b.soft}
     bodies = []
     for i in range(p.getNumBodies()):
         body = p.getBodyUniqueId(i)
@@ -63,9 +64,12 @@ def capture(scene) -> dict[str, Any]:
         for j in range(p.getNumJoints(body)):
             q, qdot = p.getJointStateMultiDof(body, j)[:2]
             joints.append({"position": list(q), "velocity": list(qdot)})
-        bodies.append({"body": body, "position": list(position), "orientation": list(orientation),
-                       "linear_velocity": list(linear), "angular_velocity": list(angular), "joints": joints})
-    positions, orientations = truth.link_frames(p, [(b.body, b.link) for b in scene.bindings])
+        entry = {"body": body, "position": list(position), "orientation": list(orientation),
+                 "linear_velocity": list(linear), "angular_velocity": list(angular), "joints": joints}
+        if body in soft:
+            entry["nodes"] = truth.nodes(p, body).tolist()
+        bodies.append(entry)
+    positions, orientations = truth.link_frames(p, truth.items_of(scene.bindings))
     targets = [{"name": b.name, "body": b.body, "link": b.link, "position": positions[i].tolist(),
                 "orientation": orientations[i].tolist()} for i, b in enumerate(scene.bindings)]
     return {"bodies": bodies, "targets": targets}
@@ -76,6 +80,11 @@ def restore(scene, state: dict[str, Any]) -> None:
     p = scene.p
     for entry in state["bodies"]:
         body = entry["body"]
+        if "nodes" in entry:
+            # A soft body's nodes, put back bit for bit (measured); pyBullet has no call that sets their velocities,
+            # so a restored soft body is right for a picture, not for stepping on.
+            p.resetMeshData(body, vertices=entry["nodes"])
+            continue
         p.resetBasePositionAndOrientation(body, entry["position"], entry["orientation"])
         p.resetBaseVelocity(body, entry["linear_velocity"], entry["angular_velocity"])
         for j, joint in enumerate(entry["joints"]):
@@ -109,6 +118,14 @@ def compare(live: dict[str, Any], stored: dict[str, Any]) -> PhysicsDifference:
     a, b = live["targets"], stored["targets"]
     if [t["name"] for t in a] != [t["name"] for t in b]:
         return PhysicsDifference(float("inf"), float("inf"), "(the targets differ: other scene parameters?)")
+    names = {t["body"]: t["name"] for t in a}
+    for x, y in zip(live["bodies"], stored["bodies"]):
+        if "nodes" in x or "nodes" in y:  # a soft body: its nodes are its pose
+            if len(x.get("nodes", ())) != len(y.get("nodes", ())):
+                return PhysicsDifference(float("inf"), float("inf"), f"{names.get(x['body'], x['body'])!r} (other nodes)")
+            far = float(np.linalg.norm(np.subtract(x["nodes"], y["nodes"]), axis=1).max(initial=0.0))
+            if far > POSITION_TOLERANCE:
+                return PhysicsDifference(far, 0.0, f"{names.get(x['body'], x['body'])!r} (its nodes)")
     pa = np.array([t["position"] for t in a], dtype=float)
     pb = np.array([t["position"] for t in b], dtype=float)
     qa = np.array([t["orientation"] for t in a], dtype=float)
@@ -128,12 +145,15 @@ def compare(live: dict[str, Any], stored: dict[str, Any]) -> PhysicsDifference:
 
 
 def nudged(scene, distance: float = 1e-9) -> None:
-    """Move every dynamic body's base by ``distance`` along x, keeping its velocity (a reset alone
-    zeroes it): the smallest difference another platform's floating point could make."""
+    """Move every dynamic body's base (every soft body's nodes) by ``distance`` along x, keeping its velocity
+    (a reset alone zeroes it): the smallest difference another platform's floating point could make."""
     p = scene.p
+    soft = {b.body for b in scene.bindings if b.soft}
     for i in range(p.getNumBodies()):
         body = p.getBodyUniqueId(i)
-        if p.getDynamicsInfo(body, -1)[0] > 0:
+        if body in soft:  # every node; resetMeshData keeps the nodes' velocities (measured: a reset to itself changes nothing)
+            p.resetMeshData(body, vertices=(truth.nodes(p, body) + [distance, 0.0, 0.0]).tolist())
+        elif p.getDynamicsInfo(body, -1)[0] > 0:
             (x, y, z), orientation = p.getBasePositionAndOrientation(body)
             linear, angular = p.getBaseVelocity(body)
             p.resetBasePositionAndOrientation(body, [x + distance, y, z], orientation)

@@ -7,7 +7,9 @@ when the actor was built) moved by pybullet's pose of that link frame:
   "Frames"); the base link frame is that frame composed with the inverse of the local inertial
   frame from ``getDynamicsInfo(body, -1)[3:5]``;
 * a link: ``getLinkState(body, link, computeForwardKinematics=1)[4:6]``, the URDF link frame, with
-  forward kinematics recomputed so the pose is not one step stale.
+  forward kinematics recomputed so the pose is not one step stale;
+* a soft body has no pose: each vertex belongs at its node, ``getMeshData(body, -1,
+  flags=MESH_DATA_SIMULATION_MESH)`` (:func:`nodes`); its item's frame is the identity (:data:`NODES`).
 
 Nothing here reads a sync implementation's state or an actor.
 
@@ -26,7 +28,8 @@ from scipy.spatial.transform import Rotation
 from conformance.bullet import poses
 from conformance.bullet.client import BoundClient
 
-__all__ = ["aabb_half_extents", "expected_vertices", "frames_of", "link_frame", "link_frames", "read_states"]
+__all__ = ["NODES", "aabb_half_extents", "expected_vertices", "frames_of", "items_of", "link_frame", "link_frames", "nodes",
+           "nodes_of", "read_states", "soft_vertices"]
 
 
 def link_frame(p: BoundClient, body: int, link: int) -> tuple[np.ndarray, np.ndarray]:
@@ -38,6 +41,17 @@ def link_frame(p: BoundClient, body: int, link: int) -> tuple[np.ndarray, np.nda
         return poses.compose(com_pos, com_orn, inv_pos, inv_orn)
     state = p.getLinkState(body, link, computeForwardKinematics=1)
     return np.asarray(state[4], dtype=np.float64), np.asarray(state[5], dtype=np.float64)
+
+
+#: The "link" of a soft body's item: it is drawn at its nodes, in the world, so its frame is the identity
+#: (``getDynamicsInfo`` of a soft body reports uninitialised memory where a base's inertial frame would be).
+NODES = -2
+
+
+def items_of(targets) -> list[tuple[int, int]]:
+    """The (body, link) item of each target or binding for :func:`link_frames`: a soft body's is (body, NODES)."""
+    return [(t.body, NODES if getattr(t, "nodes", None) is not None or getattr(t, "soft", False) else t.link)
+            for t in targets]
 
 
 def link_frames(p: BoundClient, items: Sequence[tuple[int, int]]) -> tuple[np.ndarray, np.ndarray]:
@@ -55,23 +69,30 @@ def read_states(p: BoundClient, items: Sequence[tuple[int, int]]) -> tuple:
     client = p.client
     links: dict[int, list[int]] = {}
     bases = []
+    soft = []
     for i, (body, link) in enumerate(items):
         if link >= 0:
             links.setdefault(body, []).append(i)
+        elif link == NODES:
+            soft.append(i)
         else:
             bases.append(i)
     states = [(rows, pybullet.getLinkStates(body, [items[i][1] for i in rows], computeForwardKinematics=1,
                                             physicsClientId=client)) for body, rows in links.items()]
     com = [pybullet.getBasePositionAndOrientation(items[i][0], physicsClientId=client) for i in bases]
     inertial = [pybullet.getDynamicsInfo(items[i][0], -1, physicsClientId=client)[3:5] for i in bases]
-    return len(items), states, bases, com, inertial
+    nodes_read = [(i, pybullet.getMeshData(items[i][0], -1, flags=pybullet.MESH_DATA_SIMULATION_MESH,
+                                           physicsClientId=client)[1]) for i in soft]
+    return len(items), states, bases, com, inertial, nodes_read
 
 
 def frames_of(states: tuple) -> tuple[np.ndarray, np.ndarray]:
     """The link-frame poses (positions ``(n, 3)``, quaternions ``(n, 4)``) of :func:`read_states`' reading."""
-    n, links, bases, com, inertial = states
+    n, links, bases, com, inertial, nodes_read = states
     positions = np.empty((n, 3))
     orientations = np.empty((n, 4))
+    soft = [i for i, _ in nodes_read]
+    positions[soft], orientations[soft] = 0.0, (0.0, 0.0, 0.0, 1.0)
     for rows, found in links:
         for i, state in zip(rows, found):
             positions[i], orientations[i] = state[4], state[5]
@@ -86,6 +107,31 @@ def frames_of(states: tuple) -> tuple[np.ndarray, np.ndarray]:
         positions[bases] = np.array([c[0] for c in com]) - frame_rot.apply(np.array([l[0] for l in inertial]))
         orientations[bases] = frame_rot.as_quat()
     return positions, orientations
+
+
+def nodes(p: BoundClient, body: int) -> np.ndarray:
+    """The world positions ``(n, 3)`` of soft body ``body``'s simulated nodes now (``getMeshData(body, -1,
+    flags=MESH_DATA_SIMULATION_MESH)``; without the flag pyBullet gives the visual mesh, which may differ)."""
+    found = pybullet.getMeshData(body, -1, flags=pybullet.MESH_DATA_SIMULATION_MESH, physicsClientId=p.client)[1]
+    return np.asarray(found, dtype=np.float64).reshape(-1, 3)
+
+
+def soft_vertices(p: BoundClient, targets) -> dict[int, np.ndarray]:
+    """Where each soft target's vertices belong now, by target index: its nodes (``Target.nodes``) as
+    :func:`nodes` reads them, one read per body."""
+    read: dict[int, np.ndarray] = {}
+    found = {}
+    for i, t in enumerate(targets):
+        if t.nodes is not None:
+            if t.body not in read:
+                read[t.body] = nodes(p, t.body)
+            found[i] = read[t.body][t.nodes]
+    return found
+
+
+def nodes_of(states: tuple) -> dict[int, np.ndarray]:
+    """The node positions ``(n, 3)`` of each soft item (by item index) in :func:`read_states`' reading."""
+    return {i: np.asarray(found, dtype=np.float64).reshape(-1, 3) for i, found in states[5]}
 
 
 def expected_vertices(local: np.ndarray, position, orientation) -> np.ndarray:

@@ -14,7 +14,7 @@ import sys
 from typing import Any, Mapping
 
 from conformance import scenes
-from conformance.bullet import state
+from conformance.bullet import state, truth
 
 __all__ = ["MAX_STEPS", "digest", "digests_in_subprocess", "first_divergence"]
 
@@ -24,17 +24,20 @@ MAX_STEPS = 400
 
 def digest(name: str, params: Mapping[str, Any] | None = None, steps: int | None = None,
            spec: "scenes.SceneSpec | None" = None) -> str:
-    """SHA-1 of the bytes of every binding's pose and velocity after each of ``steps`` frames
+    """SHA-1 of the bytes of every binding's pose and velocity (a soft body's nodes) after each of ``steps`` frames
     (default: the scene's step count, at most :data:`MAX_STEPS`)."""
     spec = spec or scenes.get(name)
     h = hashlib.sha1()
     with spec.build(**(params or {})) as scene:
         count = min(scene.steps, MAX_STEPS) if steps is None else steps
+        soft = [b.body for b in scene.bindings if b.soft]
         h.update(scene.poses().tobytes())
         for step in range(count):
             scene.advance(step)
             h.update(scene.poses().tobytes())
             h.update(scene.velocities().tobytes())
+            for body in soft:  # a soft body's pose says little of its shape: its nodes
+                h.update(truth.nodes(scene.p, body).tobytes())
     return h.hexdigest()
 
 

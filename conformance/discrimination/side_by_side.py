@@ -210,7 +210,7 @@ def _gaps(run_a, run_b) -> list[float]:
 
 
 def _poses(run) -> np.ndarray:
-    positions, orientations = truth.link_frames(run.drawing.world.p, [(t.body, t.link) for t in run.drawing.targets])
+    positions, orientations = truth.link_frames(run.drawing.world.p, truth.items_of(run.drawing.targets))
     return np.concatenate([positions, orientations], axis=1)
 
 

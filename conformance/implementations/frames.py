@@ -18,7 +18,8 @@ from scipy.spatial.transform import Rotation
 
 from conformance.world import Target
 
-__all__ = ["IDENTITY_FRAME", "LinkFrames", "SharedActor", "inertial_frames", "pybullet_matrices_are_exact", "shared_actors", "split"]
+__all__ = ["IDENTITY_FRAME", "LinkFrames", "SharedActor", "SoftBodies", "inertial_frames", "pybullet_matrices_are_exact",
+           "shared_actors", "split"]
 
 IDENTITY_FRAME = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))
 _flatten = itertools.chain.from_iterable
@@ -148,10 +149,35 @@ class SharedActor:
         array[self.block] = moved.reshape(-1, 3)  # one rounding to the array's type (float32)
 
 
+class SoftBodies:
+    """The soft bodies' targets (``Target.nodes``): each frame, every soft body's simulated nodes read once
+    (``getMeshData(body, -1, flags=MESH_DATA_SIMULATION_MESH)``) and copied into its vertices, announced."""
+
+    def __init__(self, client: int, targets: list[Target], points: Callable[[Any], np.ndarray],
+                 announce: Callable[[Any, bool], None]):
+        self.client, self.targets, self._points, self._announce = client, targets, points, announce
+
+    def __call__(self) -> None:
+        read: dict[int, np.ndarray] = {}
+        for t in self.targets:
+            if t.body not in read:
+                nodes = pybullet.getMeshData(t.body, -1, flags=pybullet.MESH_DATA_SIMULATION_MESH,
+                                             physicsClientId=self.client)[1]
+                read[t.body] = np.asarray(nodes, dtype=np.float64)
+            self._points(t.actor)[t.start:t.stop] = self.vertices(t, read[t.body])
+            self._announce(t.actor, False)
+
+    def vertices(self, t: Target, nodes: np.ndarray) -> np.ndarray:
+        """What target ``t``'s vertices become, given its body's ``nodes`` now: the nodes it follows."""
+        return nodes[t.nodes]
+
+
 def split(client: int, targets: tuple[Target, ...], direct_allowed: bool) -> tuple[list, list, dict]:
-    """``(direct, rest, inertial)``: the targets a reference sync poses straight from
+    """``(direct, rest, inertial)``: the rigid targets a reference sync poses straight from
     ``getBasePositionAndOrientation`` (whole actors of bases whose link frame is their centre of mass,
-    when ``direct_allowed``), every other target, and each base's inertial frame."""
+    when ``direct_allowed``), every other rigid target, and each base's inertial frame. Soft bodies'
+    targets are in neither (:class:`SoftBodies` draws them)."""
+    targets = tuple(t for t in targets if t.nodes is None)
     inertial = inertial_frames(client, targets)
 
     def is_direct(t: Target) -> bool:

@@ -15,7 +15,7 @@ __all__ = ["ActorRecipe", "BrickRecipe", "Combined", "JointRecipe", "Recipe", "V
 
 
 def actor_recipe(t: Target) -> bool:
-    return not t.shared
+    return not t.shared and t.nodes is None  # the guide has no recipe for soft bodies: the reference draws them
 
 
 def vertex_recipe(t: Target) -> bool:

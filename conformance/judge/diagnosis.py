@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 import pybullet
 
-from conformance.bullet import poses
+from conformance.bullet import poses, truth
 
 __all__ = ["EULER_ORDERS", "MISTAKES", "NORMAL_MISTAKES", "Drawn", "diagnose", "diagnose_frame", "diagnose_normals",
            "diagnose_problems", "drawn_now", "explain", "explain_frame", "explain_normals", "unannounced"]
@@ -50,6 +50,18 @@ MISTAKES = {
     "translation-only": "moved but never turned: the position is pyBullet's, the rotation the one it was built with",
     "rotation-only": "turned but never moved: the rotation is pyBullet's, the position the one it was built with",
     "other-target": "drawn at the pose of {other}: the vertex range or the actor was paired with the wrong body or link",
+    "node-order": "each vertex is drawn at one of the soft body's nodes, but not at the node it follows: the nodes "
+                  "were copied in another order than the faces index them; copy getMeshData(body, -1, "
+                  "flags=p.MESH_DATA_SIMULATION_MESH)[1][t.nodes] in order",
+}
+
+_COPY = "copy getMeshData(body, -1, flags=p.MESH_DATA_SIMULATION_MESH)[1] after p.stepSimulation(), at every call"
+#: The words of a mistake found on a soft body, whose drawing follows nodes, not a pose.
+SOFT_WORDS = {
+    "previous-step": "drawn exactly at the soft body's nodes of the previous step (frame {frame}): " + _COPY,
+    "never-moved": "drawn at the soft body's nodes as built: its vertices were never copied again; " + _COPY,
+    "late-or-once": "drawn at the soft body's nodes of the previous step (frame {frame}), which are the nodes as "
+                    "built: copied one step late or only once, which the next frames tell apart; " + _COPY,
 }
 
 #: name → what it means, for a target whose vertices are right and whose stored normals are not
@@ -102,6 +114,9 @@ class _Physics:
     previous: tuple[np.ndarray, np.ndarray] | None
     before_events: list[tuple[Any, tuple[np.ndarray, np.ndarray]]]
     com: tuple[np.ndarray, np.ndarray]
+    #: Each soft target's body's nodes now and at the previous step (None at frame 0), by target index.
+    nodes: dict[int, np.ndarray]
+    previous_nodes: dict[int, np.ndarray] | None
 
 
 def _physics(run) -> _Physics:
@@ -116,7 +131,8 @@ def _physics(run) -> _Physics:
         else:
             pos, orn = pybullet.getLinkState(body, link, computeForwardKinematics=1, physicsClientId=p.client)[:2]
         com_pos[i], com_orn[i] = pos, orn
-    return _Physics(run.poses(), run.previous, list(run.before_events), (com_pos, com_orn))
+    nodes = {i: truth.nodes(p, t.body) for i, t in enumerate(run.drawing.targets) if t.nodes is not None}
+    return _Physics(run.poses(), run.previous, list(run.before_events), (com_pos, com_orn), nodes, run.previous_nodes)
 
 
 def drawn_now(run, names, frame: int) -> dict[str, Drawn]:
@@ -188,6 +204,8 @@ def explain(run, drawn: Drawn, tolerance: float) -> tuple[str, str] | None:
     local = run.drawing.local[drawn.index]
     if not len(local) or not np.all(np.isfinite(drawn.vertices)):
         return None
+    if run.drawing.targets[drawn.index].nodes is not None:
+        return _explain_soft(run, drawn, tolerance)
     physics = drawn.physics
     true_p, true_r = _pose(physics.now, drawn.index)
     truth_vertices = local @ true_r.T + true_p
@@ -198,6 +216,35 @@ def explain(run, drawn: Drawn, tolerance: float) -> tuple[str, str] | None:
             continue  # this mistake would have drawn it (nearly) right here: it cannot explain the error
         if np.max(np.linalg.norm(expected - drawn.vertices, axis=1)) <= allowance:
             return name, "diagnosis: " + MISTAKES[name].format(**words)
+    return None
+
+
+def _explain_soft(run, drawn: Drawn, tolerance: float) -> tuple[str, str] | None:
+    """:func:`explain` for a soft body's target: its vertices tried at the previous step's nodes, at the
+    nodes as built, and at the body's nodes now in any order."""
+    i, t = drawn.index, run.drawing.targets[drawn.index]
+    now = drawn.physics.nodes[i]
+    truth_vertices, allowance = now[t.nodes], 2 * tolerance
+    candidates = []
+    if drawn.physics.previous_nodes is not None and i in drawn.physics.previous_nodes:
+        candidates.append(("previous-step", {"frame": drawn.frame - 1}, drawn.physics.previous_nodes[i][t.nodes]))
+    candidates.append(("never-moved", {}, run.drawing.local[i]))
+    held = []
+    for name, words, expected in candidates:
+        if np.max(np.linalg.norm(expected - truth_vertices, axis=1)) <= DISTINCT * allowance:
+            continue  # this mistake would have drawn it (nearly) right here: it cannot explain the error
+        if np.max(np.linalg.norm(expected - drawn.vertices, axis=1)) <= allowance:
+            held.append((name, words))
+    if held:
+        name, words = held[0]
+        # At frame 1 the previous step's nodes are the built ones: the name stays the first that holds
+        words_of = "late-or-once" if [n for n, _ in held] == ["previous-step", "never-moved"] else name
+        return name, "diagnosis: " + SOFT_WORDS[words_of].format(**words)
+    from scipy.spatial import cKDTree
+
+    distance, nearest = cKDTree(now).query(drawn.vertices)
+    if np.all(distance <= allowance) and np.any(nearest != t.nodes):
+        return "node-order", "diagnosis: " + MISTAKES["node-order"]
     return None
 
 

@@ -48,10 +48,12 @@ def measure(scene_names, draws: int, seed: int = 0, keep=None) -> list[dict]:
             events = ()
             if turns:
                 with scenes.build(scene_name, **params) as probe:
-                    events = turning_everything(len({b.body for b in probe.bindings}), turns)
+                    events = turning_everything(len({b.body for b in probe.rigid}), turns)
             with runner.running(scene_name, reference, events=events, **params) as run:
                 run.advance(frames)
                 scene = run.scene
+                if not silhouettes.pybullet_draws_it(scene, run.frame):
+                    return
                 fury = backends.render_ids(run.drawing, scene.camera, scene.image_size)
                 bullet = silhouettes.pybullet_mask(scene, scene.bindings, scene.camera, scene.image_size)
                 record = silhouettes.compare_silhouettes(

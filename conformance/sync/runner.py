@@ -42,7 +42,7 @@ class Run:
         #: (frame, actor name) of every sync that changed an actor's data without telling the renderer.
         self.unannounced: list[tuple[int, str, str]] = []  # (frame, actor, what was not announced)
         self._after: dict[str, tuple[int, bytes]] = {}
-        self._items = [(t.body, t.link) for t in self.drawing.targets]
+        self._items = truth.items_of(self.drawing.targets)
         # pyBullet's readings of every target when the current frame began, before its events and step
         # (the previous step's), and just before each event so far: the earlier poses a diagnosis tries
         # (:mod:`conformance.judge.diagnosis`). Kept as the run goes, because replaying the physics to find
@@ -55,6 +55,11 @@ class Run:
         """pyBullet's link-frame poses of every target (positions, quaternions) at the previous step,
         when the current frame began (None at frame 0)."""
         return None if self._previous is None else truth.frames_of(self._previous)
+
+    @property
+    def previous_nodes(self) -> dict[int, Any] | None:
+        """Each soft target's nodes (by target index, all of its body's) at the previous step (None at frame 0)."""
+        return None if self._previous is None else truth.nodes_of(self._previous)
 
     @property
     def before_events(self) -> list[tuple[Event, tuple[Any, Any]]]:

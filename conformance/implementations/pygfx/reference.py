@@ -23,7 +23,7 @@ import numpy as np
 import pybullet
 from scipy.spatial.transform import Rotation
 
-from conformance.implementations.frames import LinkFrames, shared_actors, split
+from conformance.implementations.frames import LinkFrames, SoftBodies, shared_actors, split
 from conformance.world import Target, World
 
 __all__ = ["ReferenceSync"]
@@ -47,6 +47,9 @@ def _announce(actor, normals: bool) -> None:
 class ReferenceSync:
     """Exact, vectorised sync: world vertices = pybullet link-frame pose × geometry captured at set-up."""
 
+    #: What draws the soft bodies' targets (a subclass may draw them otherwise).
+    soft_bodies = SoftBodies
+
     def __init__(self, world: World, targets: tuple[Target, ...] | None = None):
         self.p, self.client = world.p, world.client
         self.targets = tuple(world.targets if targets is None else targets)
@@ -58,6 +61,8 @@ class ReferenceSync:
         self._frames = LinkFrames(self.client, tuple(rest), inertial) if rest else None
         self._whole = [(i, t.actor) for i, t in enumerate(rest) if not t.shared]
         self._shared = shared_actors(rest, _points, _normals, _announce)
+        soft = [t for t in self.targets if t.nodes is not None]
+        self._soft = self.soft_bodies(self.client, soft, _points, _announce) if soft else None
 
     def _poses(self) -> tuple[np.ndarray, np.ndarray]:
         """Link-frame positions ``(n, 3)`` and rotation matrices ``(n, 3, 3)`` of the targets drawn from
@@ -66,6 +71,8 @@ class ReferenceSync:
         return self._frames()
 
     def __call__(self) -> None:
+        if self._soft is not None:
+            self._soft()
         if self._direct_bodies:
             poses = map(pybullet.getBasePositionAndOrientation, self._direct_bodies, itertools.repeat(self.client))
             for pose, transform in zip(poses, self._direct_transforms):

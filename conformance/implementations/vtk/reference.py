@@ -33,7 +33,7 @@ import pybullet
 from vtkmodules.util import numpy_support
 from vtkmodules.vtkCommonMath import vtkMatrix4x4
 
-from conformance.implementations.frames import LinkFrames, pybullet_matrices_are_exact, shared_actors, split
+from conformance.implementations.frames import LinkFrames, SoftBodies, pybullet_matrices_are_exact, shared_actors, split
 from conformance.world import Target, World
 
 __all__ = ["ReferenceSync"]
@@ -58,6 +58,9 @@ def _modified(actor, normals: bool) -> None:
 class ReferenceSync:
     """Exact, vectorised sync: world vertices = pybullet link-frame pose × geometry captured at set-up."""
 
+    #: What draws the soft bodies' targets (a subclass may draw them otherwise).
+    soft_bodies = SoftBodies
+
     def __init__(self, world: World, targets: tuple[Target, ...] | None = None):
         self.p, self.client = world.p, world.client
         self.targets = tuple(world.targets if targets is None else targets)
@@ -72,6 +75,8 @@ class ReferenceSync:
         self._unattached = list(zip([t.actor for t in direct], self._direct_matrices))
         self._unattached += [(rest[i].actor, matrix) for i, matrix in self._whole]
         self._shared = shared_actors(rest, _points, _normals, _modified)
+        soft = [t for t in self.targets if t.nodes is not None]
+        self._soft = self.soft_bodies(self.client, soft, _points, _modified) if soft else None
 
     def _poses(self) -> tuple[np.ndarray, np.ndarray]:
         """Link-frame positions ``(n, 3)`` and rotation matrices ``(n, 3, 3)`` of the targets drawn from
@@ -80,6 +85,8 @@ class ReferenceSync:
         return self._frames()
 
     def __call__(self) -> None:
+        if self._soft is not None:
+            self._soft()
         copy = vtkMatrix4x4.DeepCopy  # (matrix, 16 numbers): sets them and calls Modified()
         if self._direct_bodies:
             rotation = pybullet.getMatrixFromQuaternion
