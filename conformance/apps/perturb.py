@@ -45,7 +45,7 @@ def _scene(client: int, frames: list[Frame], dynamic: bool):
     p = BoundClient(client)
     wanted = sorted({f.body for f in frames if f.client == client and f.link == -1 and f.node < 0 and (f.mass > 0 or not dynamic)})
     dt = p.getPhysicsEngineParameters()["fixedTimeStep"]
-    return SimpleNamespace(p=p, bindings=[SimpleNamespace(body=b) for b in wanted], dt=dt)
+    return SimpleNamespace(p=p, bindings=[SimpleNamespace(body=b, soft=False) for b in wanted], dt=dt)
 
 
 def apply(events, tick: int, frames: list[Frame]) -> None:
