@@ -8,7 +8,6 @@ them; ``tests/test_soft_bodies.py`` runs them there.
 
 from __future__ import annotations
 
-
 from conformance.bullet import truth
 from conformance.implementations.frames import SoftBodies
 from conformance.implementations.reference import ReferenceSync
