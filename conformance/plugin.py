@@ -13,6 +13,8 @@ Options live under one group, each mirrored by an ini setting:
   of :mod:`conformance.judge.tolerances`.
 * ``--conformance-report PATH`` / ``conformance_report``: write every check's outcome, scene and
   worst measured error as JSON (what ``python -m conformance verdicts`` reads).
+* ``--conformance-summary PATH`` / ``conformance_summary``: write the run's Markdown summary there
+  (:mod:`conformance.reports.summary`); it is added to ``$GITHUB_STEP_SUMMARY`` too, when that is set.
 * Pictures (:mod:`conformance.checks.image_options` reads and validates them):
   ``--conformance-golden-dir DIR`` / ``conformance_golden_dir`` (default: each scene's own goldens: the kit's, or golden/<backend>/ beside your scene file),
   ``--conformance-image-tolerance auto|same-renderer|other-renderer`` / ``conformance_image_tolerance``,
@@ -42,8 +44,12 @@ _RECORDS_KEY = pytest.StashKey[list]()
 _SELECTED_KEY = pytest.StashKey[dict]()
 #: per scene, how many of its checks -k or -m left out: its PASS then covers the selected ones only
 _DESELECTED_KEY = pytest.StashKey[dict]()
+#: per scene, why its checks were left out (``-m 'not soft'``, ``-k 'chain'``, ``--shard 1/2``) and how many each
+_LEFT_OUT_KEY = pytest.StashKey[dict]()
 #: The name under which each check's record rides on its report (``report.user_properties``).
 _RECORD_PROPERTY = "conformance_record"
+#: Whether a check of the kit reported in this session (else it writes no summary: an unrelated suite's run).
+_KIT_RAN_KEY = pytest.StashKey[bool]()
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:
@@ -75,6 +81,11 @@ def pytest_addoption(parser: pytest.Parser) -> None:
     group.addoption("--conformance-report", dest="conformance_report", metavar="PATH", default=None,
                     help="write each check's outcome, scene and worst error as JSON to PATH")
     parser.addini("conformance_report", "default for --conformance-report", default=None)
+    group.addoption("--conformance-summary", dest="conformance_summary", metavar="PATH", default=None,
+                    help="write the run's summary as Markdown to PATH: each scene's verdict, the first failure with its "
+                    "diagnosis and reproduce line, every failing check, links to pictures (added to "
+                    "$GITHUB_STEP_SUMMARY as well, when set)")
+    parser.addini("conformance_summary", "default for --conformance-summary", default=None)
     group.addoption("--conformance-survey", dest="conformance_survey", action="store_true", default=None,
                     help="survey mode: a check notes every failure and runs every frame, then fails with the first "
                     "failure and every kind that failed with its worst figure (what 'verdicts' uses; default: stop "
@@ -208,6 +219,8 @@ def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line("markers", "sync: a check that runs the sync implementation under test (added automatically)")
     config.addinivalue_line("markers", "draws: a check whose examples are drawn at random (Hypothesis; added automatically "
                             "to a @given check): what `precision` and the kit's random-draw slice run")
+    config.addinivalue_line("markers", "soft: a check of a scene with soft bodies (cloth, soft_ball; added automatically): "
+                            "-m 'not soft' leaves them out, for a program that has no soft bodies")
     # pytest-xdist registers it itself; without xdist installed the kit's grouping of a scene's checks
     # would otherwise warn as an unknown mark in every run.
     config.addinivalue_line("markers", "xdist_group(name): checks pytest-xdist runs in one worker (one scene's)")
@@ -219,6 +232,8 @@ def pytest_configure(config: pytest.Config) -> None:
     # stalls after a worker crashes (conformance.session.isolation), so the kit no longer asks for it;
     # --dist loadgroup given by the user still groups by the marks added below.
     config.pluginmanager.register(_Records(config), "conformance-records")
+    if not hasattr(config, "workerinput"):
+        config.pluginmanager.register(_Summary(), "conformance-summary")
     import os
 
     from conformance.session import selection
@@ -325,9 +340,13 @@ def pytest_collection_modifyitems(session: pytest.Session, config: pytest.Config
     if placeholders:  # no app configured: the app checks are not collected at all
         items[:] = [item for item in items if item not in placeholders]
         config.hook.pytest_deselected(items=placeholders)
+    soft = {}
     for item in items:
         if _is_property(item):
             item.add_marker(pytest.mark.draws)
+        marker = item.get_closest_marker("scene")
+        if marker is not None and _has_soft_bodies(marker.args[0], soft):
+            item.add_marker(pytest.mark.soft)  # before pytest's own -m deselection, which runs after this hook
     uses_sync = [item for item in items if "sync_implementation" in getattr(item, "fixturenames", ())]
     for item in uses_sync:
         item.add_marker(pytest.mark.sync)
@@ -345,6 +364,16 @@ def pytest_collection_modifyitems(session: pytest.Session, config: pytest.Config
         config.stash[_SYNC_KEY] = _limited(config, load(_sync_spec(config)))
     except SyncError as err:
         raise pytest.UsageError(str(err)) from None
+
+
+def _has_soft_bodies(scene: str, known: dict) -> bool:
+    """Whether ``scene`` is one of the registered scenes with soft bodies (``SceneSpec(deformable=True)``);
+    ``known`` caches the answers of one collection."""
+    if scene not in known:
+        from conformance import scenes
+
+        known[scene] = scene in scenes.names() and bool(scenes.get(scene).deformable)
+    return known[scene]
 
 
 def _limited(config: pytest.Config, implementation):
@@ -443,9 +472,25 @@ def pytest_runtest_makereport(item: pytest.Item, call):
             "message": message.strip().splitlines()[0][:4000] if message.strip() else "",
             # test_golden_render: each golden frame's sync and renderer verdicts (conformance.rendering.reftest).
             "golden_verdicts": [v for k, v in item.user_properties if k == GOLDEN_VERDICTS],
-            "diagnosis": next((line[len("diagnosis: "):] for line in message.splitlines() if line.startswith("diagnosis: ")), ""),
+            "diagnosis": _after(message, "diagnosis: ", leading=True),
+            "reproduce": _after(message, "reproduce: "),
         }))
+    if _is_the_kits(item):
+        from conformance.reports import junit
+
+        junit.lead_with_the_diagnosis(report)  # after the record, which keeps the message as the check made it
     return report
+
+
+def _after(message: str, label: str, *, leading: bool = False) -> str:
+    """What follows ``label`` on the first line of ``message`` that has it (``leading``: that starts with it,
+    indented or not), or ''."""
+    for line in message.splitlines():
+        text = line.strip()
+        at = (0 if text.startswith(label) else -1) if leading else text.find(label)
+        if at >= 0:
+            return text[at + len(label):]
+    return ""
 
 
 def _only_the_paragraph(call, report: pytest.TestReport) -> None:
@@ -482,6 +527,8 @@ class _Records:
     def pytest_runtest_logreport(self, report: pytest.TestReport) -> None:
         if hasattr(self.config, "workerinput"):
             return
+        if "conformance" in report.keywords:  # the kit's package name, among the keywords of each of its checks
+            self.config.stash[_KIT_RAN_KEY] = True
         for name, record in report.user_properties:
             if name == _RECORD_PROPERTY:
                 record = dict(record)
@@ -512,17 +559,104 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus) -> None:
     write_atomically(path, json.dumps(payload, indent=1, default=float).encode("utf-8"))  # never half a report
 
 
+class _Summary:
+    """Writes the run's summary when the session ends, in the process that writes the report page (pytest's own,
+    or the pytest-xdist controller): the second half of a wrapper, so after every plugin's ``pytest_sessionfinish``,
+    when the page is written and the exit status final (the selection's check may make a green run's 5)."""
+
+    @pytest.hookimpl(wrapper=True)
+    def pytest_sessionfinish(self, session: pytest.Session):
+        result = yield
+        _write_summary(session)
+        return result
+
+
+def _write_summary(session: pytest.Session) -> None:
+    """The run's Markdown summary, to the file ``--conformance-summary`` names and added to ``$GITHUB_STEP_SUMMARY``,
+    in a session where a check of the kit reported (a suite of the user's own, in the same environment, gets none)."""
+    import os
+
+    from conformance.checks import image_options
+
+    config = session.config
+    pictures = image_options.from_config(config)
+    options = _summary_targets(config)
+    if not any(options) or not config.stash.get(_KIT_RAN_KEY, False):
+        return
+    from conformance import backends
+    from conformance.errors import BackendError
+    from conformance.reports import artefacts, summary
+
+    try:
+        backend = backends.describe()
+    except BackendError:
+        backend = "no FURY installed"
+    selection = config.pluginmanager.get_plugin("conformance-selection")
+    report = getattr(pictures, "report_path", None)
+    github = [os.environ.get(name, "") for name in ("GITHUB_SERVER_URL", "GITHUB_REPOSITORY", "GITHUB_RUN_ID")]
+    run = summary.Run(
+        sync=_sync_spec(config), backend=backend, exitstatus=int(session.exitstatus),
+        scenes=_scene_rows(config, _stopped(session, session.exitstatus)), records=config.stash.get(_RECORDS_KEY, []),
+        pictures=artefacts.read_records(pictures.results), results=pictures.results, report=report,
+        shard=config.getoption("conformance_shard"),
+        artifacts=f"{github[0]}/{github[1]}/actions/runs/{github[2]}#artifacts" if all(github) else None,
+        extra=[selection.message] if getattr(selection, "message", "") else [])
+    path, step = options
+    if path is not None:
+        summary.write(run, path)
+    if step is not None:
+        summary.append(run, step)
+
+
+def _summary_targets(config: pytest.Config) -> tuple:
+    """(the ``--conformance-summary`` file, ``$GITHUB_STEP_SUMMARY``), each None when not given; checked when
+    pytest was configured (:func:`conformance.validation.plugin_options`)."""
+    from conformance import validation
+    from conformance.errors import BadArgument
+
+    try:
+        return _option(config, "summary"), validation.step_summary()
+    except BadArgument as err:
+        raise pytest.UsageError(str(err)) from None
+
+
 def pytest_deselected(items) -> None:
     if not items:
         return
     kept = items[0].config.stash.setdefault(_DESELECTED_KEY, {})
+    why = items[0].config.stash.setdefault(_LEFT_OUT_KEY, {})
     for item in items:
         marker = item.get_closest_marker("scene")
         if marker is not None:
             kept[marker.args[0]] = kept.get(marker.args[0], 0) + 1
+            reasons = why.setdefault(marker.args[0], {})
+            reason = _why_deselected(item)
+            reasons[reason] = reasons.get(reason, 0) + 1
+
+
+def _why_deselected(item: pytest.Item) -> str:
+    """What left ``item`` out: ``-m EXPR`` when the marker expression does not match it (``-m 'not soft'``,
+    from the command line or the ini's ``addopts``), else ``-k EXPR``, else ``--shard K/N``, else "deselected"."""
+    option = item.config.option
+    try:  # pytest's own matchers, as its -m and -k use them
+        from _pytest.mark import KeywordMatcher, MarkMatcher
+        from _pytest.mark.expression import Expression
+
+        for flag, expression, matcher in (("-m", getattr(option, "markexpr", ""), lambda: MarkMatcher.from_markers(item.iter_markers())),
+                                          ("-k", getattr(option, "keyword", ""), lambda: KeywordMatcher.from_item(item))):
+            if expression and not Expression.compile(expression).evaluate(matcher()):
+                return f"{flag} {expression!r}"
+    except Exception:  # pytest's internals moved, or its parser refused the expression: say less, never fail
+        return "deselected"
+    shard = item.config.getoption("conformance_shard", None)
+    return f"--shard {shard}" if shard else "deselected"
 
 
 def pytest_collection_finish(session: pytest.Session) -> None:
+    if hasattr(session.config, "workeroutput"):  # for the pytest-xdist controller, which prints the verdicts
+        # also when every check was left out (-m 'not soft' on the soft scenes alone): the table says why
+        session.config.workeroutput["conformance_deselected"] = dict(session.config.stash.get(_DESELECTED_KEY, {}))
+        session.config.workeroutput["conformance_left_out"] = dict(session.config.stash.get(_LEFT_OUT_KEY, {}))
     if not session.items:
         return
     counts: dict[str, int] = defaultdict(int)
@@ -531,9 +665,8 @@ def pytest_collection_finish(session: pytest.Session) -> None:
         if marker is not None:
             counts[marker.args[0]] += 1
     session.config.stash[_SELECTED_KEY] = dict(counts)
-    if hasattr(session.config, "workeroutput"):  # for the pytest-xdist controller, which prints the verdicts
+    if hasattr(session.config, "workeroutput"):
         session.config.workeroutput["conformance_selected"] = dict(counts)
-        session.config.workeroutput["conformance_deselected"] = dict(session.config.stash.get(_DESELECTED_KEY, {}))
 
 
 @pytest.hookimpl(optionalhook=True)
@@ -548,6 +681,10 @@ def pytest_testnodedown(node, error) -> None:
     for scene, count in getattr(node, "workeroutput", {}).get("conformance_deselected", {}).items():
         left_out = node.config.stash.setdefault(_DESELECTED_KEY, {})
         left_out[scene] = max(left_out.get(scene, 0), count)
+    for scene, reasons in getattr(node, "workeroutput", {}).get("conformance_left_out", {}).items():
+        kept = node.config.stash.setdefault(_LEFT_OUT_KEY, {}).setdefault(scene, {})
+        for reason, count in reasons.items():
+            kept[reason] = max(kept.get(reason, 0), count)
 
 
 def _scene_verdict(outcomes: dict, selected: int | None, stopped: bool) -> tuple[str, str]:
@@ -567,28 +704,49 @@ def _scene_verdict(outcomes: dict, selected: int | None, stopped: bool) -> tuple
     return ("PASS" if passed else "SKIP"), detail
 
 
-def pytest_terminal_summary(terminalreporter, exitstatus, config: pytest.Config) -> None:
-    from conformance.checks import image_options
+def _stopped(session, exitstatus) -> bool:
+    """Whether the run ended before every selected check ran (Ctrl-C, -x, --maxfail)."""
+    return exitstatus == pytest.ExitCode.INTERRUPTED or bool(session is not None and (session.shouldstop or session.shouldfail))
 
-    image_options.from_config(config).summarize(terminalreporter)
-    verdicts = config.stash.get(_VERDICT_KEY, None)
-    if not verdicts:
-        return
-    tr = terminalreporter
-    from conformance import backends
 
-    tr.section(f"conformance verdict per scene (sync {_sync_spec(config)!r}, {backends.NAME} backend)")
+def _scene_rows(config: pytest.Config, stopped: bool) -> list[tuple[str, str, str]]:
+    """(verdict, scene, detail) of every scene the run reported or selected, in the order they reported; then
+    each scene that a marker expression left out whole (``-m 'not soft'``: LEFT OUT, and why). A scene that
+    only -k or --shard left out is not listed: those name the scenes a run is for."""
+    verdicts = config.stash.get(_VERDICT_KEY, None) or {}
     selected = config.stash.get(_SELECTED_KEY, None)
-    session = getattr(tr, "_session", None)
-    stopped = exitstatus == pytest.ExitCode.INTERRUPTED or bool(session is not None and (session.shouldstop or session.shouldfail))
-    scenes = list(verdicts) + [scene for scene in (selected or {}) if scene not in verdicts]
-    width = max(len(name) for name in scenes)
-    words = max(len(_scene_verdict(verdicts.get(s, {}), (selected or {}).get(s) if selected is not None else None, stopped)[0])
-                for s in scenes)
-    for scene in scenes:
+    rows = []
+    for scene in list(verdicts) + [scene for scene in (selected or {}) if scene not in verdicts]:
         verdict, detail = _scene_verdict(verdicts.get(scene, {}), selected.get(scene) if selected is not None else None, stopped)
         left_out = config.stash.get(_DESELECTED_KEY, {}).get(scene, 0)
         if left_out:  # a PASS of the checks that were asked for, not of the scene
             detail += f"; {left_out} of its checks not selected (-k, -m)"
+        rows.append((verdict, scene, detail))
+    for scene, reasons in config.stash.get(_LEFT_OUT_KEY, {}).items():
+        if scene in verdicts or (selected or {}).get(scene) or not any(r.startswith("-m ") for r in reasons):
+            continue
+        count = sum(reasons.values())
+        why = " and ".join(sorted(reasons, key=lambda r: (not r.startswith("-m "), -reasons[r])))
+        rows.append(("LEFT OUT", scene, f"left out: {why} deselected its {count} checks"
+                     + (" (a scene with soft bodies)" if _has_soft_bodies(scene, {}) else "")))
+    return rows
+
+
+def pytest_terminal_summary(terminalreporter, exitstatus, config: pytest.Config) -> None:
+    from conformance.checks import image_options
+
+    image_options.from_config(config).summarize(terminalreporter)
+    tr = terminalreporter
+    rows = _scene_rows(config, _stopped(getattr(tr, "_session", None), exitstatus))
+    # Nothing reported: no table, unless -m left out every scene it would list (a run that checked nothing says why)
+    if not config.stash.get(_VERDICT_KEY, None) and (
+            not rows or config.option.collectonly or any(verdict != "LEFT OUT" for verdict, _, _ in rows)):
+        return
+    from conformance import backends
+
+    tr.section(f"conformance verdict per scene (sync {_sync_spec(config)!r}, {backends.NAME} backend)")
+    width = max(len(scene) for _, scene, _ in rows)
+    words = max(len(verdict) for verdict, _, _ in rows)
+    for verdict, scene, detail in rows:
         tr.write_line(f"{verdict:{max(words, 4)}}  {scene:<{width}}  {detail}", red=verdict == "FAIL",
                       yellow=verdict in ("INCOMPLETE", "NOT RUN"), green=verdict == "PASS")

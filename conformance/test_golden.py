@@ -33,6 +33,7 @@ import pytest
 from conformance import scenes
 from conformance.errors import GoldenError
 from conformance.checks.pytest_helpers import each_golden_variant, each_scene, variant_id
+from conformance.judge import diagnosis
 
 
 def _reproduce(check: str, scene: str, sync: str, variant: dict | None = None, pictures=None) -> str:
@@ -86,6 +87,8 @@ def test_golden_render(scene_name, variant, kit, pictures, request):
         goldens = _goldens(pictures, run.scene, scenes.get(scene_name).defaults)
         physics = {v.frame: v for v in snapshots.check_physics(scene_name, goldens)}
         drawn = {frame: snapshots.draw(run, golden) for frame, golden in goldens.items()}
+        # A soft body drawn as a rigid one (a sync written before soft bodies) is named before any picture.
+        soft = diagnosis.soft_drawn_as_rigid(run, kit.tolerance)
     # Drawn after the sync's run is closed: one live scene at a time, as an application has.
     references = reftest.references(scene_name, goldens, variant)
     failures, blamed = [], []
@@ -110,6 +113,8 @@ def test_golden_render(scene_name, variant, kit, pictures, request):
         # Each frame's two verdicts, the failed one first: what the sync did apart from what the renderer did.
         lines = [f"{line} [{where}, frame {r.frame}, sync {kit.sync!r}]" for r in failures
                  for line in sorted(r.message.splitlines(), key=lambda line: " FAIL: " not in line)]
+        if soft:
+            lines.insert(1, soft)
         lines += blamed
         lines.append(f"pictures: {pictures.results} (report.html); reproduce: {failures[0].reproduce}")
         pytest.fail("\n".join(lines), pytrace=False)

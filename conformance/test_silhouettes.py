@@ -17,6 +17,7 @@ from conformance.checks import image_options, shared_run, strategies
 from conformance.bullet.events import Teleport
 from conformance.checks.profiles import check_settings
 from conformance.checks.pytest_helpers import _context, each_scene
+from conformance.judge import diagnosis
 from conformance.rendering import framing, golden, silhouettes
 
 def assert_passed(record, run, sync: str) -> None:
@@ -46,8 +47,10 @@ def _silhouettes(run, kit):
     kit._node.stash.setdefault(_SEEN, []).append((record, silhouettes.mask_images(ids_fury, ids_bullet) if keep else {}))
     if not record.passed:
         worst = max(record.details["targets"], key=lambda t: t["off"] / max(t["allowed_off"], 1))
-        kit.fail("silhouette", f"{record.message} {_context(run, kit.sync, run.frame)}\nreproduce: {record.reproduce}\n"
-                 f"the same run's vertices, frame by frame: {record.details['replay']}",
+        soft = diagnosis.soft_drawn_as_rigid(run, kit.tolerance)  # a sync written before soft bodies: told first
+        lines = [f"{record.message} {_context(run, kit.sync, run.frame)}", *([soft] if soft else []),
+                 f"reproduce: {record.reproduce}", f"the same run's vertices, frame by frame: {record.details['replay']}"]
+        kit.fail("silhouette", "\n".join(lines),
                  value=worst["off"], limit=worst["allowed_off"], unit="pixels off", frame=run.frame,
                  target=worst["target"])
 

@@ -39,6 +39,7 @@ __all__ = [
     "MAX_IMAGE_SIDE",
     "MAX_JOBS",
     "MAX_STEPS",
+    "STEP_SUMMARY_VAR",
     "SYNC_ENV_VAR",
     "TOLERANCE_OPTIONS",
     "PluginOptions",
@@ -61,6 +62,7 @@ __all__ = [
     "report_path",
     "resolve_sync",
     "shard",
+    "step_summary",
     "sync_spec",
     "whole_number",
 ]
@@ -79,6 +81,8 @@ MAX_JOBS = 256
 #: The environment variable that names the sync when neither --sync nor the ini does (``conformance.sync.ENV_VAR``).
 SYNC_ENV_VAR = "CONFORMANCE_SYNC"
 DEFAULT_SYNC = "reference"
+#: GitHub Actions' file of a step's Markdown summary, shown on the run's page: the kit adds its summary there.
+STEP_SUMMARY_VAR = "GITHUB_STEP_SUMMARY"
 #: ``--conformance-isolation``: a serial run in a worker process of its own (``conformance.session.isolation``).
 ISOLATION_CHOICES = ("auto", "process", "none")
 
@@ -311,6 +315,15 @@ def report_path(name: str, value: Any) -> Path:
     return path
 
 
+def step_summary(environ: Mapping[str, str] | None = None) -> Path | None:
+    """Where a run's Markdown summary goes on GitHub Actions (``$GITHUB_STEP_SUMMARY``), or None. The variable is
+    GitHub's, not the kit's: unset or empty, there is none (``GITHUB_STEP_SUMMARY= pytest …`` keeps one run's
+    summary off the page); set, it must be a file the kit may write."""
+    environ = os.environ if environ is None else environ
+    value = environ.get(STEP_SUMMARY_VAR, "")
+    return file_to_write(STEP_SUMMARY_VAR, value) if value else None
+
+
 def animation_path(name: str, value: Any) -> Path:
     """Where ``render --gif`` writes: a ``.gif`` (or ``.mp4``) file to write."""
     return file_to_write(name, value, suffixes=(".gif", ".mp4"))
@@ -347,6 +360,8 @@ class PluginOptions:
     results: Path
     keep_passing: bool
     regen: bool
+    summary: Path | None = None  # the Markdown summary's file (--conformance-summary)
+    step_summary: Path | None = None  # $GITHUB_STEP_SUMMARY, which the summary is added to
 
 
 def _given(config, name: str) -> tuple[str, Any]:
@@ -371,6 +386,8 @@ def plugin_option(config, name: str) -> Any:
         return finite_non_negative(label, value)
     if name == "report":
         return report_path(label, value)
+    if name == "summary":
+        return file_to_write(label, value)
     if name == "isolation":
         return choice(label, value, ISOLATION_CHOICES)
     if name == "image_tolerance":
@@ -400,4 +417,6 @@ def plugin_options(config) -> PluginOptions:
         results=results if results is not None else Path(DEFAULT_RESULTS),
         keep_passing=bool(keep if keep is not None else config.getini("conformance_keep_passing")),
         regen=bool(config.getoption("conformance_regen_golden", False)),
+        summary=plugin_option(config, "summary"),
+        step_summary=step_summary(),
     )

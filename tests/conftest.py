@@ -35,6 +35,9 @@ pytest_plugins = ["pytester", "tiers"]  # tiers: the fast tier (CI) and --full
 import os  # noqa: E402
 
 os.environ.pop("CONFORMANCE_KIT_BACKEND", None)
+# Run on GitHub Actions, every kit run these tests start would add its summary to the job's page (the plugin
+# writes to $GITHUB_STEP_SUMMARY); the tests of the summary set it themselves.
+os.environ.pop("GITHUB_STEP_SUMMARY", None)
 
 
 def pytest_collection_modifyitems(items):

@@ -167,6 +167,8 @@ def _assert_usage_error(result, *needles: str) -> None:
     (["--conformance-report", ""], "--conformance-report='' (str), but should be the path of a JSON file to write"),
     (["--conformance-report", "no/such/dir/r.json"], "make the directory"),
     (["--conformance-report", "."], "--conformance-report='.' (str)"),
+    (["--conformance-summary", ""], "--conformance-summary='' (str), but should be the path of a file to write"),
+    (["--conformance-summary", "."], "--conformance-summary='.' (str), but should be the path of a file to write; it is a directory"),
     (["--conformance-image-tolerance", "loose"], "--conformance-image-tolerance='loose' (str), but should be one of "
                                                  "auto, same-renderer, other-renderer"),
     (["--conformance-results", ""], "--conformance-results='' (str), but should be a directory"),
@@ -181,6 +183,7 @@ def test_plugin_option_is_a_usage_error(pytester, args, needle):
     ("conformance_atol = inf", "ini conformance_atol=inf (float)"),
     ("conformance_size_rtol =", "ini conformance_size_rtol='' (str)"),
     ("conformance_report =", "ini conformance_report='' (str)"),
+    ("conformance_summary =", "ini conformance_summary='' (str), but should be the path of a file to write"),
     ("conformance_image_tolerance =", "ini conformance_image_tolerance='' (str)"),
     ("conformance_results =", "ini conformance_results='' (str)"),
 ])
@@ -192,6 +195,17 @@ def test_ini_value_present_but_bad_is_a_usage_error(pytester, line, needle):
 def test_empty_sync_variable_is_a_usage_error(pytester, monkeypatch):
     monkeypatch.setenv(sync.ENV_VAR, "")
     _assert_usage_error(pytester.runpytest(*RUN), "CONFORMANCE_SYNC='' (str)", "unset it for the default")
+
+
+def test_a_step_summary_the_kit_cannot_write_is_a_usage_error(pytester, monkeypatch):
+    monkeypatch.setenv(validation.STEP_SUMMARY_VAR, str(pytester.path))
+    _assert_usage_error(pytester.runpytest(*RUN), f"GITHUB_STEP_SUMMARY={str(pytester.path)!r} (str)", "it is a directory")
+
+
+def test_an_unset_or_empty_step_summary_is_none_and_a_file_is_taken():
+    """GitHub's variable, not the kit's: empty turns the step summary off for one run, rather than being refused."""
+    assert validation.step_summary({}) is None and validation.step_summary({validation.STEP_SUMMARY_VAR: ""}) is None
+    assert validation.step_summary({validation.STEP_SUMMARY_VAR: "/tmp/step_summary"}) == Path("/tmp/step_summary")
 
 
 def test_good_tolerances_are_used(pytester):

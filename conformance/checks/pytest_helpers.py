@@ -100,9 +100,12 @@ def _largest(failures: Sequence[Any]) -> Any:
     return max(failures, key=lambda r: (r.error != r.error, r.error))  # NaN first, then largest
 
 
-def _drawn(run: Any, results: Sequence[Any]) -> dict[str, Any]:
-    """What the failing targets ``results`` are drawn as now, for their diagnoses (made later, if at all)."""
-    return diagnosis.drawn_now(run, {r.target for r in results}, results[0].frame)
+def _drawn(run: Any, results: Sequence[Any], failures: Sequence[Any] = ()) -> dict[str, Any]:
+    """What the failing targets ``results`` are drawn as now, and those of ``failures`` that are soft bodies,
+    for their diagnoses (made later, if at all)."""
+    soft = diagnosis.soft_names(run)
+    return diagnosis.drawn_now(run, {r.target for r in results} | {r.target for r in failures if r.target in soft},
+                               results[0].frame)
 
 
 def _vertices_message(failures: Sequence[Any], run: Any, sync: str, worst: Any = None, drawn=None, tolerance=None) -> str:
@@ -111,10 +114,10 @@ def _vertices_message(failures: Sequence[Any], run: Any, sync: str, worst: Any =
     if worst is None:
         worst = _largest(failures)
     lines = [f"{worst.describe()} {_context(run, sync, worst.frame)}"]
-    if drawn and worst.target in drawn:
-        found = diagnosis.diagnose(run, drawn[worst.target], worst.tolerance)
+    if drawn:  # a soft body drawn as a rigid one first, whichever target is the worst
+        found = diagnosis.explain_failures(run, drawn, worst, failures)
         if found:
-            lines.append(found)
+            lines.append(found[1])
     if len(failures) > 1:
         others = ", ".join(sorted({r.target for r in failures} - {worst.target}))
         lines.append(f"{len(failures)} targets out of tolerance at this frame" + (f" (also: {others[:300]})" if others else ""))
@@ -145,7 +148,7 @@ def assert_vertices_match(results: Iterable[Any], *, run: Any, sync: str) -> Non
     __tracebackhide__ = True
     failures = [r for r in results if not r.ok]
     if failures:
-        pytest.fail(_vertices_message(failures, run, sync, drawn=_drawn(run, [_largest(failures)])), pytrace=False)
+        pytest.fail(_vertices_message(failures, run, sync, drawn=_drawn(run, [_largest(failures)], failures)), pytrace=False)
 
 
 def assert_geometry_matches(results: Iterable[Any], *, scene: str, params: Mapping[str, Any], frame: int) -> None:
@@ -234,7 +237,7 @@ class Kit:
             worst = max(failures, key=_by_ratio)
             # What the failing targets are drawn as, read only if a message or picture is made (a survey
             # notes every failing frame and words few of them), always at this frame.
-            drawn = functools.lru_cache(maxsize=None)(lambda: _drawn(run, [worst, _largest(failures)]))
+            drawn = functools.lru_cache(maxsize=None)(lambda: _drawn(run, [worst, _largest(failures)], failures))
             # The figure is the worst in tolerances, and so is its message; the first failure's message
             # stays default mode's own (about the largest error in metres).
             first = _vertices_message(failures, run, sync, drawn=drawn(), tolerance=self.tolerance) if self.survey is None else None

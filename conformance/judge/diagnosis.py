@@ -25,8 +25,9 @@ import pybullet
 
 from conformance.bullet import poses, truth
 
-__all__ = ["EULER_ORDERS", "MISTAKES", "NORMAL_MISTAKES", "Drawn", "diagnose", "diagnose_frame", "diagnose_normals",
-           "diagnose_problems", "drawn_now", "explain", "explain_frame", "explain_normals", "unannounced"]
+__all__ = ["EULER_ORDERS", "MISTAKES", "NORMAL_MISTAKES", "SOFT_WORDS", "Drawn", "diagnose", "diagnose_frame",
+           "diagnose_normals", "diagnose_problems", "drawn_now", "explain", "explain_failures", "explain_frame",
+           "explain_normals", "soft_drawn_as_rigid", "soft_names", "unannounced"]
 
 #: name → what it means (printed after "diagnosis: ")
 MISTAKES = {
@@ -62,7 +63,14 @@ SOFT_WORDS = {
     "never-moved": "drawn at the soft body's nodes as built: its vertices were never copied again; " + _COPY,
     "late-or-once": "drawn at the soft body's nodes of the previous step (frame {frame}), which are the nodes as "
                     "built: copied one step late or only once, which the next frames tell apart; " + _COPY,
+    # A sync written before soft bodies, which hands every target to its pose code: kept under the
+    # JUnit message's share of a diagnosis (conformance.reports.junit), so that -m "not soft" stays in it.
+    "drawn-as-rigid": "{name} is a soft body (Target.nodes is not None) and the sync {how}: its vertices must follow "
+                      "the nodes p.getMeshData(body, -1, flags=p.MESH_DATA_SIMULATION_MESH)[1] (README, The sync "
+                      "protocol). No soft bodies in your program? -m \"not soft\" leaves soft scenes out",
 }
+#: How a sync drew a soft body as a rigid one, in the words of ``SOFT_WORDS["drawn-as-rigid"]``.
+_AS_RIGID = {"posed": "posed it as if rigid", "untouched": "never wrote its vertices"}
 
 #: name → what it means, for a target whose vertices are right and whose stored normals are not
 NORMAL_MISTAKES = {
@@ -117,6 +125,11 @@ class _Physics:
     #: Each soft target's body's nodes now and at the previous step (None at frame 0), by target index.
     nodes: dict[int, np.ndarray]
     previous_nodes: dict[int, np.ndarray] | None
+    #: The soft targets whose actor's vertex data the sync has never written (nor announced) so far, by index.
+    untouched: frozenset[int] = frozenset()
+    #: Each soft target's poses as a sync written for rigid bodies reads them: its base's centre of mass
+    #: (``getBasePositionAndOrientation``) and the link frame made from it with ``getDynamicsInfo(body, -1)[3:5]``.
+    rigid_poses: dict[int, list[tuple[np.ndarray, np.ndarray]]] | None = None
 
 
 def _physics(run) -> _Physics:
@@ -131,8 +144,28 @@ def _physics(run) -> _Physics:
         else:
             pos, orn = pybullet.getLinkState(body, link, computeForwardKinematics=1, physicsClientId=p.client)[:2]
         com_pos[i], com_orn[i] = pos, orn
-    nodes = {i: truth.nodes(p, t.body) for i, t in enumerate(run.drawing.targets) if t.nodes is not None}
-    return _Physics(run.poses(), run.previous, list(run.before_events), (com_pos, com_orn), nodes, run.previous_nodes)
+    soft = [i for i, t in enumerate(run.drawing.targets) if t.nodes is not None]
+    nodes = {i: truth.nodes(p, run.drawing.targets[i].body) for i in soft}
+    names = {id(actor): name for name, actor in run.drawing.actors.items()}
+    wrote = getattr(run, "wrote", None)
+    untouched = frozenset(i for i in soft if wrote is not None and names.get(id(run.drawing.targets[i].actor)) not in wrote)
+    rigid = {i: _rigid_poses(p, run.drawing.targets[i].body, com_pos[i], com_orn[i]) for i in soft}
+    return _Physics(run.poses(), run.previous, list(run.before_events), (com_pos, com_orn), nodes, run.previous_nodes,
+                    untouched, rigid)
+
+
+def _rigid_poses(p, body: int, com_pos, com_orn) -> list[tuple[np.ndarray, np.ndarray]]:
+    """(position, rotation matrix) of soft body ``body`` as a rigid body's pose code reads it: its centre of
+    mass, and the link frame the README's example makes of it (pyBullet's inertial frame of a soft body is not
+    a rotation one can rely on: one that is no rotation at all is left out)."""
+    com_r = poses.matrices(com_orn)
+    found = [(np.asarray(com_pos, dtype=np.float64), com_r)]
+    inertial_pos, inertial_orn = pybullet.getDynamicsInfo(body, -1, physicsClientId=p.client)[3:5]
+    inertial_orn = np.asarray(inertial_orn, dtype=np.float64)
+    if np.all(np.isfinite(inertial_orn)) and np.linalg.norm(inertial_orn) > 0.5:
+        r = com_r @ poses.matrices(inertial_orn).T
+        found.append((np.asarray(com_pos, dtype=np.float64) - r @ np.asarray(inertial_pos, dtype=np.float64), r))
+    return found
 
 
 def drawn_now(run, names, frame: int) -> dict[str, Drawn]:
@@ -225,6 +258,10 @@ def _explain_soft(run, drawn: Drawn, tolerance: float) -> tuple[str, str] | None
     i, t = drawn.index, run.drawing.targets[drawn.index]
     now = drawn.physics.nodes[i]
     truth_vertices, allowance = now[t.nodes], 2 * tolerance
+    built = run.drawing.local[i]
+    if i in drawn.physics.untouched:  # whatever its transform, its vertices were never copied from the nodes
+        how = "untouched" if np.max(np.linalg.norm(drawn.vertices - built, axis=1)) <= allowance else "posed"
+        return "drawn-as-rigid", _as_rigid(t, how)
     candidates = []
     if drawn.physics.previous_nodes is not None and i in drawn.physics.previous_nodes:
         candidates.append(("previous-step", {"frame": drawn.frame - 1}, drawn.physics.previous_nodes[i][t.nodes]))
@@ -240,6 +277,12 @@ def _explain_soft(run, drawn: Drawn, tolerance: float) -> tuple[str, str] | None
         # At frame 1 the previous step's nodes are the built ones: the name stays the first that holds
         words_of = "late-or-once" if [n for n, _ in held] == ["previous-step", "never-moved"] else name
         return name, "diagnosis: " + SOFT_WORDS[words_of].format(**words)
+    for position, matrix in (drawn.physics.rigid_poses or {}).get(i, ()):  # its vertices rewritten at a rigid pose
+        expected = built @ matrix.T + position
+        if np.max(np.linalg.norm(expected - truth_vertices, axis=1)) <= DISTINCT * allowance:
+            continue
+        if np.max(np.linalg.norm(expected - drawn.vertices, axis=1)) <= allowance:
+            return "drawn-as-rigid", _as_rigid(t, "posed")
     from scipy.spatial import cKDTree
 
     distance, nearest = cKDTree(now).query(drawn.vertices)
@@ -248,20 +291,61 @@ def _explain_soft(run, drawn: Drawn, tolerance: float) -> tuple[str, str] | None
     return None
 
 
+def _as_rigid(t, how: str) -> str:
+    return "diagnosis: " + SOFT_WORDS["drawn-as-rigid"].format(name=repr(t.name), how=_AS_RIGID[how])
+
+
 def diagnose(run, drawn: Drawn, tolerance: float) -> str:
     """The ``diagnosis: …`` line of :func:`explain`, or ``""``."""
     found = explain(run, drawn, tolerance)
     return found[1] if found else ""
 
 
+def soft_names(run) -> set[str]:
+    """The names of ``run``'s soft bodies' targets (``Target.nodes`` is not None)."""
+    return {t.name for t in run.drawing.targets if t.nodes is not None}
+
+
+def explain_failures(run, drawn: dict[str, Drawn], worst, failures) -> tuple[str, str] | None:
+    """:func:`explain` for a frame's failing vertex results ``failures``: a soft body drawn as a rigid one
+    first, whichever target is the worst (a sync written before soft bodies is told so before anything
+    else), then the worst result's (``worst``) mistake. ``drawn``: what the failing targets are drawn as
+    (:func:`drawn_now`; those not in it are not tried)."""
+    soft = soft_names(run)
+    for result in sorted((r for r in failures if r.target in soft and r.target in drawn), key=lambda r: r is not worst):
+        found = explain(run, drawn[result.target], result.tolerance)
+        if found and found[0] == "drawn-as-rigid":
+            return found
+    return explain(run, drawn[worst.target], worst.tolerance) if worst.target in drawn else None
+
+
 def explain_frame(run, results) -> tuple[str, str] | None:
-    """:func:`explain` for the worst (in tolerances) failing vertex result of ``run`` as it stands now."""
+    """:func:`explain` for the failing vertex results of ``run`` as it stands now: a soft body drawn as a
+    rigid one, else the worst (in tolerances) result's mistake."""
     failing = [r for r in results if not r.ok]
     if not failing:
         return None
     worst = max(failing, key=lambda r: r.error / r.tolerance if r.tolerance else r.error)
-    drawn = drawn_now(run, {worst.target}, worst.frame)
-    return explain(run, drawn[worst.target], worst.tolerance) if worst.target in drawn else None
+    soft = soft_names(run)
+    drawn = drawn_now(run, {worst.target} | {r.target for r in failing if r.target in soft}, worst.frame)
+    return explain_failures(run, drawn, worst, failing)
+
+
+def soft_drawn_as_rigid(run, tolerance=None) -> str:
+    """The ``diagnosis: …`` line of a soft body of ``run`` drawn, as it stands now, as a rigid body (the
+    picture checks' failures lead with it), or ``""``: none is, or the run has no soft body."""
+    from conformance.judge import compare
+
+    soft = soft_names(run)
+    if not soft:
+        return ""
+    results = compare.compare_vertices(run.drawing, run.frame, *([tolerance] if tolerance is not None else []))
+    failing = [r for r in results if not r.ok and r.target in soft]
+    if not failing:
+        return ""
+    drawn = drawn_now(run, {r.target for r in failing}, run.frame)
+    found = explain_failures(run, drawn, failing[0], failing)
+    return found[1] if found and found[0] == "drawn-as-rigid" else ""
 
 
 def diagnose_frame(run, results) -> str:

@@ -129,7 +129,8 @@ class Controller:
             "kinds": {"crashed": {"value": None, "limit": None, "unit": "", "ratio": float("inf"), "at_least": False,
                                   "frame": step, "target": None, "message": message.splitlines()[0],
                                   "failures": 1}},
-            "message": message.splitlines()[0], "diagnosis": ""}))
+            "message": message.splitlines()[0], "diagnosis": "",
+            "reproduce": _reproduce(self.sync_spec, scene, crashitem)}))
         self._report_row(crashitem, scene, step, message)
 
     def _report_row(self, crashitem: str, scene, step, message: str) -> None:

@@ -41,6 +41,10 @@ class Run:
         self.built_mesh = {name: backends.mesh_signature(a) for name, a in self.drawing.actors.items()}
         #: (frame, actor name) of every sync that changed an actor's data without telling the renderer.
         self.unannounced: list[tuple[int, str, str]] = []  # (frame, actor, what was not announced)
+        #: The actors whose vertex data (positions or normals) the sync changed or announced in some call, or its
+        #: factory did (:func:`running` adds those): a soft body's actor missing here was never copied into
+        #: (:mod:`conformance.judge.diagnosis` tells a sync that drew it as a rigid body from one that copied late).
+        self.wrote: set[str] = set()
         self._after: dict[str, tuple[int, bytes]] = {}
         self._items = truth.items_of(self.drawing.targets)
         # pyBullet's readings of every target when the current frame began, before its events and step
@@ -100,6 +104,8 @@ class Run:
         self.syncer(self.frame)
         self._after = {name: backends.content_state(a) for name, a in actors.items()}
         for name, after in self._after.items():
+            if after[0] != before[name][0] or after[1] != before[name][1]:
+                self.wrote.add(name)
             missed = backends.unannounced(actors[name], before[name], after) if after[1] != before[name][1] else None
             if missed:
                 self.unannounced.append((self.frame, name, missed))
@@ -130,8 +136,13 @@ def running(scene: str, implementation: SyncImplementation, events: Sequence[Eve
             with build(scene, **params) as built:
                 client = built.client
                 drawing = backends.build(built)
+                # A soft body's actor as built, to tell whether the sync's factory wrote into it (Run.wrote).
+                soft = {id(t.actor) for t in drawing.targets if t.nodes is not None}
+                built_soft = {name: backends.content_state(a) for name, a in drawing.actors.items() if id(a) in soft}
                 syncer = implementation.start(drawing.world)
                 run = Run(scene=built, drawing=drawing, syncer=syncer, params=dict(built.params), events=tuple(events))
+                run.wrote.update(name for name, state in built_soft.items()
+                                 if backends.content_state(drawing.actors[name])[:2] != state[:2])
                 run.apply_events()
                 run.sync()
                 yield run
