@@ -20,7 +20,7 @@ STEP = "    p.stepSimulation()\n"
 #: Lines an app could not write by mistake: they break the kit's driver in the app's own process, as a
 #: bug of the kit's would. Listing frames fails before the loop; reading them fails inside a step.
 BREAK_LISTING = ("import conformance.apps.bodies as _kit\n"
-                 "def _broken(clients):\n    raise KeyError('frames')\n"
+                 "def _broken(clients, notes=None):\n    raise KeyError('frames')\n"
                  "_kit.frames_of = _broken\n")
 BREAK_READING = ("import inspect\nimport conformance.apps.bodies as _kit\n_read = _kit.read_poses\n"
                  "def _broken(frames):\n"

@@ -323,3 +323,47 @@ def test_a_face_stands_for_the_frame_that_alone_holds_one_of_its_corners():
     held.tied[:] = True
     fury, _ = pictured.labels(shot, r, [held], judged={0, 1}, background=set())
     assert set(np.unique(fury[_square()])) == {0}
+
+
+@pytest.mark.parametrize("fury_depth, left_out", [(2.05, True), (1.95, False)])
+def test_a_static_body_pyBullet_shows_in_front_hides_what_it_hides(fury_depth, left_out):
+    """Issue 47: an app that does not draw its ground shows a body's part pyBullet's ground hides (a domino
+    resting in it, a gripper turned into the floor): where pyBullet's static body is nearer than FURY's surface
+    the pixels are left out; where FURY's surface is nearer (a body drawn where pyBullet has only ground) they
+    are compared, and the body drawn there fails."""
+    from conformance.apps import pictured
+
+    fury = np.where(_square(), 0, -1)
+    bullet = np.where(_square(top=14), 0, np.where(_square(), 1, -1))  # the body's lower band: the ground, in front
+    shot = {"fury_depth": np.where(_square(), fury_depth, np.inf), "bullet_depth": np.where(bullet >= 0, 2.0, np.inf),
+            "bullet": bullet}
+    found = pictured.undecided(shot, fury, np.where(bullet == 0, 0, -1), background={1})
+    band = _square() & ~_square(top=14)
+    assert found[band].all() == left_out and found[band].any() == left_out
+    assert not found[_square(top=14) & _square()].any()  # where both show the body, nothing is left out
+
+
+def test_two_bodies_at_the_same_depth_are_a_tie_either_renderer_may_show():
+    """Coincident faces of two links (the WSG-50 gripper's motor and hinge): where the pictures show two
+    different bodies at depths within 0.1 %, each renderer's rounding chose; at different depths, the
+    pictures disagree on something real and are compared."""
+    from conformance.apps import pictured
+
+    fury, bullet = np.where(_square(), 0, -1), np.where(_square(), 2, -1)
+    for gap, tie in ((1e-5, True), (0.01, False)):
+        shot = {"fury_depth": np.where(_square(), 1.0, np.inf), "bullet_depth": np.where(_square(), 1.0 + gap, np.inf),
+                "bullet": bullet}
+        assert pictured.undecided(shot, fury, bullet, background=set())[_square()].all() == tie
+
+
+@pytest.mark.parametrize("back, left_out", [(True, True), (False, False)])
+def test_a_face_fury_shows_from_its_back_where_pybullet_shows_nothing_is_left_out(back, left_out):
+    """pyBullet's renderer culls back faces; FURY 2's meshes are two-sided: a single-sided sheet seen from below
+    (pybullet_data's cloth_z_up.urdf) shows in FURY's picture only. Its front, where pyBullet shows nothing, is
+    a body drawn where pyBullet has none, and is compared."""
+    from conformance.apps import pictured
+
+    fury, bullet = np.where(_square(), 0, -1), np.full(_square().shape, -1)
+    shot = {"fury_depth": np.where(_square(), 1.0, np.inf), "bullet_depth": np.full(fury.shape, np.inf),
+            "bullet": bullet, "fury_back": _square() & back}
+    assert pictured.undecided(shot, fury, bullet, background=set())[_square()].all() == left_out

@@ -29,7 +29,7 @@ LAYERS = [
     ("reports", ["conformance.reports."]),
     ("checks", ["conformance.checks."]),
     ("apps", ["conformance.apps."]),
-    ("discrimination", ["conformance.discrimination."]),
+    ("discrimination", ["conformance.discrimination.", "conformance.zoo."]),
     ("session", ["conformance.session."]),
     ("commands", ["conformance.commands."]),
     ("entry points", ["conformance", "conformance.__main__", "conformance.plugin", "conformance.cli",

@@ -3,7 +3,7 @@
 ``./kit test`` (what CI runs) leaves out the tests marked ``full``; ``./kit test --full`` runs them too. A
 ``full`` mark says why its test is not in CI, and it may never land on a test that carries one of CI's
 guarantees: the kill rate of every wrong and right sync and example app, the mutant sample, the README's
-examples, the random-draw slice. These tests read the marks as pytest does (module ``pytestmark`` and
+examples, the random-draw slice, the zoo's slice, the CI templates. These tests read the marks as pytest does (module ``pytestmark`` and
 each function's own), so moving a guarantee out of CI fails here, naming it.
 """
 
@@ -17,7 +17,7 @@ import pytest
 TESTS = Path(__file__).resolve().parent
 #: The modules that carry CI's guarantees: none of their tests may be in the full tier.
 GUARANTEES = ["test_discrimination", "test_examples", "test_mutants", "test_readme_example", "test_random_draws",
-              "test_tiers"]
+              "test_tiers", "test_zoo", "test_ci_templates"]
 
 
 def _marks(obj) -> list:

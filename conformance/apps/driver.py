@@ -285,7 +285,7 @@ class Driver:
         if not actors:
             raise AppLoopNotFound(f"{self.script}: the app's scene has no actor drawing polygons, so there is nothing "
                                   "to check; add the actors to the scene the ShowManager shows.")
-        self._frames = bodies.frames_of(clients)
+        self._frames = bodies.frames_of(clients, self.notes)  # a read pyBullet crashed on is left out, and said
         names = _labels(actors)
         tracks = [_Track(a, names.get(id(a)) or f"actor #{i}", self._backend) for i, a in enumerate(actors)]
         mapped = mapping.resolve(self.script, sys.modules.get("__main__"), actors, names,

@@ -9,8 +9,9 @@ Checks (the names are the pytest ids and the ``app`` command's lines):
 * ``placed``: a drawing whose shape is its frame's collision shape sits on it (:mod:`conformance.apps.placement`);
 * ``normals``: stored vertex normals turn with the frame that holds their vertices;
 * ``announced``: every change of an actor's vertex data was announced to the renderer at the tick it was made;
-* ``untouched``: after a tick's last ``stepSimulation`` — where the sync runs — the app leaves every body's pose
-  and velocity as pyBullet computed them (a sync only reads the simulation; the guide's recipes only read);
+* ``untouched``: after a tick's last ``stepSimulation`` — where the sync runs — the app never writes a body's own
+  pose back into pyBullet (a sync only reads the simulation; the guide's recipes only read); a body it moves
+  there on purpose (kinematic playback) is judged where pyBullet holds it when the app draws;
 * ``pictured``: the app's pictures at four ticks of the run (the last at its end), from its own camera, show
   each body where pyBullet's own renderer shows it (:mod:`conformance.apps.pictured`).
 
@@ -26,7 +27,7 @@ from scipy.spatial.transform import Rotation
 
 from conformance.apps import attachment as attach_mod, soft_bodies, welds
 from conformance.apps.verdict import DIAGNOSES, Verdict
-from conformance.apps.placement import bounding_radius, bounding_sphere, place, shape_distance
+from conformance.apps.placement import bounding_radius, bounding_sphere, candidates, place, shape_distance
 from conformance.apps.recording import Recording, vertex_ranges
 from conformance.judge.tolerances import DEFAULT, Tolerance
 
@@ -37,6 +38,8 @@ CHECKS = ("runs", "attached", "drawn", "placed", "normals", "announced", "untouc
 #: A write that changes a pose or velocity by no more than this is no change (resetting a body to the
 #: pose just read may round its last bit).
 UNTOUCHED_ATOL = 1e-12
+#: pyBullet's calls that set a pose (a write-back writes one): the driver's STATE_WRITERS but resetBaseVelocity
+POSE_WRITERS = {"resetBasePositionAndOrientation", "resetJointState", "resetJointStateMultiDof", "resetJointStatesMultiDof"}
 
 def _rotations(q: np.ndarray) -> np.ndarray:
     return Rotation.from_quat(q.reshape(-1, 4)).as_matrix().reshape(q.shape[:-1] + (3, 3))
@@ -56,10 +59,13 @@ class _Judgement:
         #: frames welded together (fixed joints): one rigid frame, whose vertices go to the member they lie on
         self.welds = welds.groups(recording.frames, recording.positions, _rotations(recording.orientations)) \
             if recording.frames else np.zeros(0, int)
-        self.attachments = [attach_mod.attach(a.vertices[1:], self.pos, self.rot, tolerance=tolerance,
-                                              event_ticks=self.event_ticks, centres=centres, radii=radii,
-                                              groups=self.welds, outside=self._outside)
-                            for a in recording.actors] \
+        #: per actor, its vertices that are not finite at some tick (NaN, infinity): drawn nowhere, judged by none
+        #: of the checks but ``attached``, which fails them
+        self.unfinite = [~np.isfinite(a.vertices[1:]).all(axis=(0, 2)) for a in recording.actors]
+        self.attachments = [_attach_finite(a.vertices[1:], bad, self.pos, self.rot, tolerance=tolerance,
+                                           event_ticks=self.event_ticks, centres=centres, radii=radii,
+                                           groups=self.welds, outside=self._outside)
+                            for a, bad in zip(recording.actors, self.unfinite)] \
             if recording.ticks else []
         self.mapped = [np.zeros(len(a.frame), dtype=bool) for a in self.attachments]
         for entry in recording.mapping:
@@ -108,6 +114,28 @@ class _Judgement:
         before_pos, before_orn = self.r.before_positions[1:], self.r.before_orientations[1:]
         return [tuple(np.asarray(a) for a in make(self.pos, self.orn, before_pos, before_orn))
                 for _, make in attach_mod.VARIANTS.values()]
+
+    @functools.cached_property
+    def _variant_stack(self) -> tuple[np.ndarray, np.ndarray]:
+        """:attr:`_variants` stacked: positions ``(V, T, F, 3)`` and rotations ``(V, T, F, 3, 3)``."""
+        shape = self.pos.shape
+        return (np.stack([np.broadcast_to(p, shape) for p, _ in self._variants]),
+                np.stack([np.broadcast_to(r, shape + (3,)) for _, r in self._variants]))
+
+    def _variants_possible(self, vertices, frame, reference, allowance, bad_ticks) -> np.ndarray:
+        """``(V,)``: whether each variant could hold the vertices, judged by the first one alone under every
+        variant at once (the test :func:`~conformance.apps.attachment.variant_fit` makes, with a hair of
+        slack): a loose piece's diagnosis tried the catalogue variant by variant, most of judging a robot
+        drawn with degrees for radians."""
+        if not vertices.shape[1] or not len(bad_ticks):
+            return np.ones(len(self._variants), dtype=bool)
+        pos, rot = self._variant_stack
+        local = np.einsum("vtji,vtj->vti", rot[:, :, frame], vertices[None, :, 0] - pos[:, :, frame])
+        limit = allowance[0] * (1 + 1e-9)
+        at_reference = np.all(np.linalg.norm(local[:, bad_ticks] - reference[0], axis=-1) <= limit, axis=1)
+        own = np.median(local, axis=1)
+        at_own = np.all(np.linalg.norm(local[:, bad_ticks] - own[:, None], axis=-1) <= limit, axis=1)
+        return at_reference | at_own
 
     @functools.cached_property
     def _radii(self) -> np.ndarray:
@@ -168,6 +196,14 @@ class _Judgement:
                 verdict.diagnosed(diagnosis)
             soft_bodies.attached(track, a, soft, verdict)
             worst = max(worst, float(ratio.max(initial=0)))
+        for track, bad in zip(self.r.actors, self.unfinite):
+            for start, stop in _runs(bad, np.zeros(len(bad), dtype=int)):
+                verdict.passed = False
+                first = int(np.flatnonzero(~np.isfinite(track.vertices[:, start:stop]).all(axis=(1, 2)))[0])
+                verdict.lines.append(
+                    f"{track.label} ({track.kind}) vertices {start}:{stop} of {len(bad)}: not finite (NaN or infinity) "
+                    f"at tick {first}: drawn nowhere, where pyBullet has a body or nothing (a zero-size shape normalised, "
+                    "a division by zero, a value never set)")
         for entry in self.r.mapping:
             self._judge_mapped(entry, verdict)
         welded = sum(int(a.welded.sum()) for a in self.attachments if a.welded is not None)
@@ -244,9 +280,18 @@ class _Judgement:
         near = distance <= 2 * radius[None, :] + 1e-9
         near[np.arange(m)[best >= 0], best[best >= 0]] = True
         score = np.full(m, np.inf)
+        ticks = len(vertices)
+        probes = np.unique(np.linspace(0, ticks - 1, 4).astype(int)) if ticks else np.arange(0)
         for f in np.flatnonzero(near.any(axis=0)):
-            rows = np.flatnonzero(near[:, f])
+            near_f = np.flatnonzero(near[:, f])
             for k, (positions, rotations) in enumerate(self._variants, start=1):
+                # Held within the allowance of one place at every tick means within twice it of the first
+                # tick's place at a few: a necessary test on 4 ticks of 40 rules most pairs out (exact).
+                probed = attach_mod.in_frame(vertices[probes][:, near_f], positions[probes, f], rotations[probes, f])
+                spread = np.max(np.linalg.norm(probed - probed[:1], axis=-1), axis=0, initial=0)
+                rows = near_f[spread <= 2 * allowance[near_f] * (1 + 1e-9)]
+                if not len(rows):
+                    continue
                 local = attach_mod.in_frame(vertices[:, rows], positions[:, f], rotations[:, f])
                 error = attach_mod._errors(local).max(axis=1) / allowance[rows]
                 better = (error <= 1.0) & (error < score[rows])
@@ -283,7 +328,10 @@ class _Judgement:
     def _diagnose(self, vertices, frame, reference, allowance, bad_ticks) -> str:
         if frame < 0:
             return ""
-        for name, (positions, rotations) in zip(attach_mod.VARIANTS, self._variants):
+        possible = self._variants_possible(vertices, frame, reference, allowance, bad_ticks)
+        for name, (positions, rotations), could in zip(attach_mod.VARIANTS, self._variants, possible):
+            if not could:
+                continue
             positions, rotations = positions[:, frame, None], rotations[:, frame, None]
             if attach_mod.variant_fit(vertices, positions, rotations, reference, allowance, bad_ticks):
                 # A late sync is late wherever the body moved; drawn right at some of those ticks, it skipped
@@ -319,7 +367,14 @@ class _Judgement:
             followed.update(int(f) for f in np.unique(a.frame[a.held]) if f >= 0)
         soft_bodies.drawn(self, verdict, followed)
         for index, frame in enumerate(self.r.frames):
-            if index in followed or not frame.shapes:
+            if not _shown(frame):
+                continue
+            if len(self.welds) and self.welds[index] >= 0:
+                # A welded frame is given the vertices on its shape that its weld holds, its neighbours' as well
+                # (a link's box whose end lies in the next link's cylinder): drawn means its shape is covered.
+                if self._drawn_on_its_weld(index, followed):
+                    continue
+            elif index in followed:
                 continue
             moved = self._movement(index, bounding_radius(frame.shapes))
             allowance = 10 * self.tolerance.for_extents(np.array([bounding_radius(frame.shapes)]),
@@ -334,6 +389,40 @@ class _Judgement:
                 verdict.diagnosed("never-moved")
         return verdict
 
+    def _drawn_on_its_weld(self, index: int, followed: set) -> bool:
+        """Whether a welded frame is drawn: the vertices its weld holds (whichever member they were given to)
+        that lie on its own shapes reach across one of them, in its own frame. An IMU link's millimetre box
+        drawn at its origin inside the trunk it is welded to (Unitree A1), a foot's sphere at the end of the
+        calf: the vertices go to the parent, and the link is drawn. The end of a link's box lying in the
+        next link's cylinder (TwoJointRobot_w_fixedJoints) does not draw that cylinder. A frame whose shapes
+        the kit cannot size (no box, sphere or cylinder, no readable visual) is drawn when any is given to it."""
+        group = self.welds[index] if len(self.welds) else -1
+        if group < 0:
+            return False
+        members = np.flatnonzero(self.welds == group)
+        if not followed.intersection(int(m) for m in members):
+            return False
+        info = self.r.frames[index]
+        shapes = candidates(info.shapes, info.mesh, info.visuals)
+        if not shapes:
+            return index in followed
+        for track, a in zip(self.r.actors, self.attachments):
+            rows = np.flatnonzero(np.isin(a.frame, members) & a.held)
+            if not len(rows):
+                continue
+            radii = track.radii[rows] if track.radii is not None else None
+            local = _drawn_points(self._reference(track.vertices[1:, rows], index), radii, np.arange(len(rows)))
+            on = local[self._outside(index, local) <= self.tolerance.bounds_rtol * bounding_sphere(info.shapes, info.mesh)[1]
+                       + 1e-9]
+            if not len(on):
+                continue
+            low, high = on.min(axis=0), on.max(axis=0)
+            for _what, _which, centre, half in shapes:
+                room = self.tolerance.bounds_rtol * 2 * float(np.max(half)) + 1e-9
+                if np.all(low <= centre - half + room) and np.all(high >= centre + half - room):
+                    return True  # the vertices on its shapes reach across one of them
+        return False
+
     def _movement(self, index: int, radius: float) -> float:
         if self.r.ticks == 0:
             return 0.0
@@ -345,6 +434,12 @@ class _Judgement:
         """An actor range held by the world that sits on this frame as it was at the start: of several near
         it, one that is the frame's shape there (its extents in the frame's axes), else the nearest (a nail
         drawn beside the rope's last bead is not that bead)."""
+        found = self._left_behind_all(index)
+        return min((not ok, distance, label) for ok, distance, label in found)[2] if found else ""
+
+    def _left_behind_all(self, index: int) -> list[tuple[bool, float, str]]:
+        """``(is the frame's shape, distance, label)`` of each actor range the world (or a body that never
+        moves) holds near where this frame was at the start (:meth:`_left_behind`)."""
         info = self.r.frames[index]
         radius = bounding_radius(info.shapes) if info.shapes else bounding_sphere(info.shapes, info.mesh)[1]
         # A frame that never moves holds what the world holds (a static ground plate): either may be named.
@@ -363,8 +458,8 @@ class _Judgement:
                 local = (points - origin) @ turn  # in the frame as it was at the start
                 placed = place(local, info.shapes, self._inertial(index), tolerance=self.tolerance, mesh=info.mesh,
                                visuals=info.visuals)
-                found.append((not (placed.judged and placed.ok), distance, f"{track.label} vertices {start}:{stop}"))
-        return min(found)[2] if found else ""
+                found.append((placed.judged and placed.ok, distance, f"{track.label} vertices {start}:{stop}"))
+        return found
 
     def placements(self) -> list:
         """``(track, attachment, frame, rows, Placement)`` of every actor's held vertices of every frame,
@@ -422,7 +517,7 @@ class _Judgement:
         # A soft body's node has a position and no turn: the normals of a surface that follows nodes turn
         # with its shape, which a right program recomputes every tick; they are not a frame's to judge.
         soft = np.array([f.node >= 0 for f in self.r.frames] + [False])  # the last entry: the world (-1)
-        for track, a in zip(self.r.actors, self.attachments):
+        for track, a, bad in zip(self.r.actors, self.attachments, self.unfinite):
             if track.normals is None:
                 continue
             if track.radii is not None:  # a shader lights impostor spheres as spheres: no stored normal is used
@@ -437,7 +532,7 @@ class _Judgement:
             angle = np.arccos(np.clip(np.einsum("tni,ni->tn", local, reference), -1, 1))
             # Vertices no frame holds fail `attached`; their normals have no frame to turn with.
             on_nodes = soft[frames] & a.held
-            judged = a.held & ~on_nodes
+            judged = a.held & ~on_nodes & ~bad & np.isfinite(angle).all(axis=0)
             if on_nodes.any():
                 verdict.notes.append(f"{track.label}: {int(on_nodes.sum())} vertices follow soft-body nodes, whose normals "
                                      "turn with the surface's shape, not with a frame: not judged")
@@ -469,7 +564,18 @@ class _Judgement:
         return verdict
 
 
+    def _writers(self, tick: int) -> set:
+        return set(self.r.writers[tick]) if tick < len(self.r.writers) else set()
+
     def untouched(self) -> Verdict:
+        """A write after the tick's last step is the app's business when it moves a body on purpose (kinematic
+        playback by ``resetJointState``, a body teleported or pushed before the draw): the drawing is then judged
+        against what pyBullet holds when it draws, as every drawing is. What a sync must never do is write its
+        own drawing back ("so physics and graphics agree"): a pose reset to what it already was, to float32
+        rounding or exactly, which still changes the simulation (the velocity is set to zero, the last bits of
+        the pose are lost). The two are told apart body by body and tick by tick by what the write changed: a
+        body whose frames all moved no further than float32 rounding of their pose (with a pose writer called)
+        was written back; a body some frame of which moved further was moved on purpose."""
         verdict = Verdict("untouched", True)
         writes = self.r.writes
         if writes is None or not np.isfinite(writes).any():
@@ -484,27 +590,75 @@ class _Judgement:
         changed = change > UNTOUCHED_ATOL
         if not changed.any():
             return verdict
-        verdict.passed = False
-        ticks = np.flatnonzero(changed.any(axis=1))
-        frames = np.flatnonzero(changed.any(axis=0))
-        tick, frame = np.unravel_index(int(np.argmax(np.where(changed, change, -1))), change.shape)
-        first = int(ticks[0])
-        calls = ", ".join(sorted({name for t in ticks for name in (self.r.writers[t] if t < len(self.r.writers) else [])}))
-        verdict.lines.append(
-            f"after the last p.stepSimulation() of tick {first}, the app's own code changed what pyBullet computed "
-            f"({calls or 'a state writer'}): {len(frames)} frame(s) on {len(ticks)} of {self.r.ticks} ticks; the most, "
-            f"{self.frame_label(int(frame))} at tick {tick}: moved {moved[tick, frame]:.3g} m, turned {turned[tick, frame]:.3g} rad, "
-            f"velocity changed by {np.nan_to_num(sped[tick, frame]):.3g} (m/s, rad/s); allowed {UNTOUCHED_ATOL:g} (a sync only reads the "
-            "simulation; move bodies on purpose before stepping)")
-        # Written back: every change no bigger than float32 rounding (with a float32 normalisation) of the value
+        # Within float32 rounding (with a float32 normalisation) of the pose it had: the drawn pose written back.
         eps = 4 * np.finfo(np.float32).eps
-        near = np.abs(after[..., :7] - before[..., :7]) <= eps * np.maximum(np.abs(before[..., :7]), 1.0)
-        pose_writers = {"resetBasePositionAndOrientation", "resetJointState", "resetJointStateMultiDof",
-                        "resetJointStatesMultiDof"}
-        if pose_writers & set(calls.split(", ")) and np.all(near[changed]):
-            verdict.diagnosed("written-back")
-        verdict.worst = float(change.max())
+        rounded = np.all(np.abs(after[..., :7] - before[..., :7]) <= eps * np.maximum(np.abs(before[..., :7]), 1.0), axis=-1)
+        bodies: dict[tuple, list[int]] = {}
+        for index, frame in enumerate(self.r.frames):
+            bodies.setdefault((frame.client, frame.body), []).append(index)
+        back = np.zeros_like(changed)   # (tick, frame): part of a body written back at that tick
+        on_purpose: dict[tuple, set] = {}
+        for tick in np.flatnonzero(changed.any(axis=1)):
+            writers = self._writers(tick)
+            for key, rows in bodies.items():
+                if not changed[tick, rows].any():
+                    continue
+                if writers & POSE_WRITERS and np.all(rounded[tick, rows]):
+                    back[tick, rows] = changed[tick, rows]
+                else:
+                    on_purpose.setdefault(key, set()).add(int(tick))
+        if on_purpose:
+            calls = ", ".join(sorted({name for ticks in on_purpose.values() for t in ticks for name in self._writers(t)}))
+            ticks = sorted(set().union(*on_purpose.values()))
+            verdict.notes.append(
+                f"the app moves {len(on_purpose)} bod{'y' if len(on_purpose) == 1 else 'ies'} on purpose after its last "
+                f"p.stepSimulation() ({calls}) on {len(ticks)} of {self.r.ticks} ticks, first at tick {ticks[0]}: what it "
+                "draws is judged against what pyBullet holds when it draws (attached)")
+        if not back.any():
+            return verdict
+        verdict.passed = False
+        ticks = np.flatnonzero(back.any(axis=1))
+        frames = np.flatnonzero(back.any(axis=0))
+        tick, frame = np.unravel_index(int(np.argmax(np.where(back, change, -1))), change.shape)
+        first = int(ticks[0])
+        calls = ", ".join(sorted({name for t in ticks for name in self._writers(t)} & POSE_WRITERS))
+        verdict.lines.append(
+            f"after the last p.stepSimulation() of tick {first}, the app's own code wrote back what pyBullet computed "
+            f"({calls}): {len(frames)} frame(s) on {len(ticks)} of {self.r.ticks} ticks set to their own pose, to float32 "
+            f"rounding or exactly; the most, {self.frame_label(int(frame))} at tick {tick}: moved {moved[tick, frame]:.3g} m, "
+            f"turned {turned[tick, frame]:.3g} rad, velocity changed by {np.nan_to_num(sped[tick, frame]):.3g} (m/s, rad/s); "
+            f"allowed {UNTOUCHED_ATOL:g} (a sync only reads the simulation)")
+        verdict.diagnosed("written-back")
+        verdict.worst = float(change[back].max())
         return verdict
+
+
+def _attach_finite(vertices: np.ndarray, bad: np.ndarray, *args, **kwargs):
+    """:func:`conformance.apps.attachment.attach` of the finite vertices of ``vertices`` ``(T, n, 3)``; the ``bad``
+    ones (not finite at some tick, ``attached`` fails them) given to the world and taken as held, so that no
+    other check reads them."""
+    if not bad.any():
+        return attach_mod.attach(vertices, *args, **kwargs)
+    ticks, n = vertices.shape[:2]
+    found = attach_mod.Attachment(frame=np.full(n, -1), error=np.zeros((n, ticks)), allowance=np.ones(n),
+                                  reference=np.zeros((n, 3)), tied=np.zeros(n, dtype=bool), welded=np.zeros(n, dtype=bool))
+    if (~bad).any():
+        good = attach_mod.attach(vertices[:, ~bad], *args, **kwargs)
+        found.frame[~bad], found.error[~bad], found.allowance[~bad] = good.frame, good.error, good.allowance
+        found.reference[~bad], found.tied[~bad] = good.reference, good.tied
+        if good.welded is not None:
+            found.welded[~bad] = good.welded
+    return found
+
+
+def _shown(frame) -> bool:
+    """Whether pyBullet's own renderer draws ``frame``, so a right program must: some visual shape of it has an
+    extent and is not invisible (alpha 0). A URDF says "a frame, no picture" with a zero-radius sphere, a
+    program hides a link with ``changeVisualShape(rgbaColor=(…, 0))``, an MJCF joint holder has no shape at
+    all: none of these is drawn (measured, pybullet 3.2.7: 0 or 1 pixel of its segmentation mask, against
+    225 for the same box visible). A recording made before the kit counted visual shapes judges by the
+    collision shape, as it did."""
+    return frame.shown > 0 if frame.shown >= 0 else bool(frame.shapes)
 
 
 def _drawn_points(reference: np.ndarray, radii: np.ndarray | None, rows: np.ndarray) -> np.ndarray:

@@ -7,16 +7,22 @@ server that has imported FURY once (:mod:`multiprocessing`'s ``forkserver``, pre
 process's environment, working directory and ``sys.path``, and runs ``atexit`` handlers as a Python
 process does at exit. Where there is no ``forkserver`` (Windows) it is ``python -m conformance.apps.child``.
 ``timeout`` bounds the whole run; an app that exceeds it, crashes or refuses to hand over its loop gives
-:class:`AppFailed` with one paragraph saying which.
+:class:`AppFailed` with one paragraph saying which. A crash is the app's unless the crashing thread was in
+the kit's own code (:func:`kit_crash_site`, read from the dump faulthandler writes): then it is
+:class:`KitFailed`, the kit's fault and no verdict on the app.
 """
 
 from __future__ import annotations
 
 import json
+import linecache
 import multiprocessing
 import os
+import re
+import signal
 import subprocess
 import sys
+import sysconfig
 import tempfile
 import threading
 import types
@@ -25,7 +31,7 @@ from pathlib import Path
 from conformance.apps import recording as recording_mod
 from conformance.errors import ConformanceError
 
-__all__ = ["AppFailed", "KitFailed", "read", "record", "server", "start", "start_server"]
+__all__ = ["AppFailed", "KitFailed", "kit_crash_site", "read", "record", "server", "start", "start_server"]
 
 #: seconds an app's whole run may take before the kit stops it
 DEFAULT_TIMEOUT = 300.0
@@ -68,6 +74,10 @@ def record(script: str | os.PathLike, *, ticks: int = 120, events=(), tick_funct
         error = Path(str(out) + ".error")
         if error.exists():
             raise AppFailed(error.read_text(encoding="utf-8").strip())
+        if returncode < 0:
+            site = kit_crash_site(stderr)
+            if site is not None:
+                raise KitFailed(_kit_crash(script, -returncode, site, stderr))
         if returncode != 0 or not out.exists():
             how = f"was killed by signal {-returncode}" if returncode < 0 else f"exited with status {returncode}"
             raise AppFailed(f"{script}: the app's process {how} before the kit had its recording (the process crashed). "
@@ -182,6 +192,74 @@ def _child_main(argv: list[str], env: dict, stderr_path: str, caller: int) -> No
         sys.stdout.flush()
         sys.stderr.flush()
     sys.exit(code)
+
+
+#: The kit's own package: a crash whose innermost frame is here is the kit's.
+_KIT = Path(__file__).resolve().parent.parent
+#: The wrappers :func:`conformance.apps.driver.install_pybullet` puts around the app's own pyBullet calls: a
+#: crash in one of them (and not deeper, in the kit's reads they call) is in the app's call, so the app's.
+STAND_INS = ("connect_", "disconnect_", "step_", "write_")
+#: Python's own library: its functions (``ctypes.string_at``, ``threading``'s) are how a call was made,
+#: not whose call it was, so the crash is placed at the frame that called them. Not the packages installed
+#: beside it (``site-packages``), which are the app's libraries.
+_STDLIB = Path(sysconfig.get_paths()["stdlib"]).resolve()
+_FRAME = re.compile(r'^\s*File "(?P<file>.*)", line (?P<line>\d+) in (?P<function>.*)$')
+
+
+def kit_crash_site(dump: str) -> tuple[Path, int, str] | None:
+    """Where the kit's own code was when the app's process crashed, from faulthandler's ``dump`` of it: the
+    file, line and function of the crashing thread's innermost frame outside Python's own library (and the
+    guard's hand-on of a read, :mod:`conformance.apps.guarded`), if that frame is the kit's and not one of
+    the :data:`STAND_INS` (there the crash is in the app's call). None
+    when the crash is the app's, or there is no dump to tell (the app's, as before: faulthandler is on in
+    every app process, so a crash in the kit's frames always has one)."""
+    for frame in _crashing_frames(dump):
+        if frame["file"].startswith("<frozen "):
+            continue
+        path = Path(frame["file"]).resolve()
+        if path.is_relative_to(_STDLIB) and not {"site-packages", "dist-packages"} & set(path.parts):
+            continue
+        if not path.is_relative_to(_KIT):
+            return None
+        if path == _KIT / "apps" / "driver.py" and frame["function"] in STAND_INS:
+            return None
+        if path == _KIT / "apps" / "guarded.py" and frame["function"] == "__call__":
+            continue  # the guard passes a read on: the call that crashed is named where the read was asked for
+        return path, int(frame["line"]), frame["function"]
+    return None
+
+
+def _crashing_frames(dump: str) -> list[re.Match]:
+    """The frames of the thread that crashed, innermost first, in faulthandler's ``dump`` (the last one in
+    it); [] if there is none."""
+    lines = (dump or "").splitlines()
+    fatal = max((i for i, line in enumerate(lines) if line.startswith("Fatal Python error:")), default=None)
+    frames: list[re.Match] = []
+    crashing = False
+    for line in lines[fatal + 1:] if fatal is not None else ():
+        if line.startswith(("Thread 0x", "Current thread", "Extension modules:")):
+            if crashing:
+                break
+            crashing = line.startswith("Current thread")
+        elif crashing and (frame := _FRAME.match(line)):
+            frames.append(frame)
+    return frames
+
+
+def _kit_crash(script, number: int, site: tuple[Path, int, str], dump: str) -> str:
+    """The paragraph of :class:`KitFailed` for a crash in the kit's code at ``site``."""
+    path, line, function = site
+    try:
+        name = f"signal {number} ({signal.Signals(number).name})"
+    except ValueError:
+        name = f"signal {number}"
+    source = linecache.getline(str(path), line).strip()
+    frames = [frame[0].strip() for frame in _crashing_frames(dump)]
+    return (f"{script}: the kit could not judge the program: its process was killed by {name} in the kit's own "
+            f"code, not in the program's: in {function}() at {path.relative_to(_KIT.parent)}:{line}"
+            + (f", `{source}`, the call that crashed" if source else "")
+            + ". The program is not at fault and nothing of it is judged; this is a fault of the kit, please report "
+            "it with this paragraph. The crashing thread's frames, innermost first: " + "; ".join(frames[:12]))
 
 
 #: where the frames of a crash's dump are the kit's or Python's own, around the app's: left out of its last words

@@ -153,9 +153,49 @@ def take(source, tracks, frames, clients, tick: int) -> dict:
         bullet[front] = np.asarray(own + [-1], dtype=np.int32)[seen[front]]
         nearest[front] = depth[front]
         pairs += touching(client, frames)
+    near, far = camera.clipping_range
+    linear = np.where(np.isfinite(nearest), far * near / (far - (far - near) * np.where(np.isfinite(nearest), nearest, 0.0)),
+                      np.inf)
     return {"tick": tick, "size": list(size), "camera": camera.as_dict(), "faces": drawn["faces"],
             "corners": drawn["corners"], "bullet": bullet, "faint": drawn["faint"], "stale": drawn["stale"], "hidden": drawn["hidden"],
-            "touching": pairs, "notes": list(drawn.get("notes", []))}
+            "touching": pairs, "notes": list(drawn.get("notes", [])),
+            "bullet_depth": linear.astype(np.float32), **dict(zip(("fury_depth", "fury_back"), (
+                a.astype(t) for a, t in zip(face_depth(drawn["faces"], drawn["corners"], points, camera, size),
+                                            (np.float32, bool)))))}
+
+
+def face_depth(faces, corners, points, camera, size) -> tuple[np.ndarray, np.ndarray]:
+    """``(h, w)`` how far in front of the camera (along its direction of view) FURY's picture shows a surface
+    at each pixel, inf where it shows none: where the pixel's ray meets the plane of the face seen there (its
+    first three corners, ``points`` being every actor's world vertices in app-wide order); inf for a face
+    that is a line, a point or seen edge-on. Beside pyBullet's depth buffer, it tells which of two things
+    each renderer shows at a pixel is in front (:func:`conformance.apps.pictured.labels`). And ``(h, w)``
+    whether the face seen there is seen from its back (its corners turn clockwise on the screen), which FURY 2
+    draws and pyBullet's renderer does not."""
+    faces = np.asarray(faces, dtype=np.int64)
+    found = np.full(faces.shape, np.inf)
+    back = np.zeros(faces.shape, dtype=bool)
+    rows, cols = np.nonzero(faces >= 0)
+    if not len(rows) or not len(points):
+        return found, back
+    from conformance.backends import projection
+
+    width, height = size
+    matrix = projection.projection_matrix(camera, size)
+    # the pixel's ray in eye space (the eye at the origin looking down -z), scaled to z = -1
+    ray = np.column_stack([((cols + 0.5) / width * 2 - 1) / matrix[0, 0], (1 - (rows + 0.5) / height * 2) / matrix[1, 1],
+                           -np.ones(len(rows))])
+    view = projection.view_matrix(camera)
+    corner = np.asarray(corners, dtype=np.int64).reshape(-1, CORNERS)[faces[rows, cols]]
+    eye = np.asarray(points, dtype=np.float64)[corner] @ view[:3, :3].T + view[:3, 3]   # (n, 3 corners, 3)
+    normal = np.cross(eye[:, 1] - eye[:, 0], eye[:, 2] - eye[:, 0])
+    facing = np.einsum("ij,ij->i", normal, ray)
+    usable = np.abs(facing) > 1e-9 * np.linalg.norm(normal, axis=1)
+    depth = np.full(len(rows), np.inf)
+    depth[usable] = np.einsum("ij,ij->i", normal[usable], eye[usable, 0]) / facing[usable]
+    found[rows, cols] = np.where(depth > 0, depth, np.inf)
+    back[rows, cols] = usable & (np.einsum("ij,ij->i", normal, eye[:, 0]) > 0)  # its normal points away from the eye
+    return found, back
 
 
 def view_angle(vertical: float | None = None, *, horizontal: float | None = None, aspect: float = 1.0) -> float:

@@ -152,8 +152,45 @@ def labels(shot: dict, recording, attachments, judged: set[int], background: set
     bullet = np.asarray(shot["bullet"], dtype=np.int64)
     bullet = np.where(bullet >= 0, table[np.where(bullet >= 0, bullet, frames)], -1)
     out = (fury == UNKNOWN) | (bullet == UNKNOWN)
+    if "fury_depth" in shot:
+        out |= undecided(shot, fury, bullet, background)
     fury[out], bullet[out] = -1, -1
     return fury.astype(np.int32), bullet.astype(np.int32)
+
+
+#: Relative depths closer than this are a tie: which of two surfaces each renderer shows is its rounding's choice.
+TIE = 1e-3
+#: FURY's surface this much (relative) behind pyBullet's static body is hidden by it: above the two depths'
+#: rounding (float32; the kit's plane through a face's corners against the tiny renderer's interpolation, 1e-6
+#: apart where both show one body), below any contact penetration seen at a grazing angle
+HIDDEN = 1e-5
+
+
+def undecided(shot: dict, fury: np.ndarray, bullet: np.ndarray, background: set[int]) -> np.ndarray:
+    """``(h, w)`` bool: the pixels the two pictures cannot be compared at, by their depths
+    (:func:`conformance.apps.picture.face_depth`, pyBullet's depth buffer):
+
+    * where pyBullet shows a static body in front of what FURY shows there. Static bodies are background in
+      both pictures, and an app may leave its ground undrawn: a domino resting in the ground by its contact
+      penetration, a gripper the kit's events turned into the floor, show in FURY's picture where pyBullet's
+      ground hides them (measured on the zoo: 82 pixels of a fallen domino's lower edge). A body FURY shows
+      *in front* of pyBullet's ground there (drawn where pyBullet has only ground) is still compared;
+    * where the two show two different bodies at the same depth (within :data:`TIE`): coincident faces of two
+      links (the WSG-50 gripper's motor and hinge meshes), where each renderer's rounding picks one;
+    * where FURY shows a face from its back and pyBullet shows no body: pyBullet's renderer culls back faces,
+      FURY 2 draws them (a single-sided cloth sheet seen from below)."""
+    fury_depth = np.asarray(shot["fury_depth"], dtype=np.float64)
+    bullet_depth = np.asarray(shot["bullet_depth"], dtype=np.float64)
+    raw = np.asarray(shot["bullet"], dtype=np.int64)
+    hidden = np.isin(raw, list(background)) & np.isfinite(bullet_depth) & (fury_depth > bullet_depth * (1 + HIDDEN))
+    # a face seen from its back, which FURY 2 draws (pygfx's meshes are two-sided) and pyBullet's renderer culls:
+    # where pyBullet shows nothing of a body there, the two renderers' rules differ, not the drawing (a cloth
+    # mesh's single-sided sheet seen from below, pybullet_data's cloth_z_up.urdf: 72,214 pixels)
+    culled = np.asarray(shot.get("fury_back", np.zeros(raw.shape, bool)), dtype=bool) & ((raw < 0) | np.isin(raw, list(background)))
+    both = np.isfinite(fury_depth) & np.isfinite(bullet_depth)
+    gap = np.abs(np.where(both, fury_depth, 0.0) - np.where(both, bullet_depth, 0.0))
+    tie = (fury >= 0) & (bullet >= 0) & (fury != bullet) & both & (gap <= TIE * np.minimum(fury_depth, bullet_depth))
+    return hidden | tie | culled
 
 
 def _decorations(judgement, unlike: set[int]) -> np.ndarray:

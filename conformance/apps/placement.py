@@ -133,8 +133,25 @@ def _hull(vertices: np.ndarray):
     except (QhullError, ValueError):
         low, high = vertices.min(axis=0), vertices.max(axis=0)
         return lambda points: np.linalg.norm(np.maximum(np.maximum(low - points, points - high), 0.0), axis=1)
-    normals, offsets = planes[:, :3].T, planes[:, 3]
-    return lambda points: np.maximum((points @ normals + offsets).max(axis=1), 0.0)
+    # In float32, about the hull's centre, a block of points at a time: a robot's link mesh has thousands of
+    # hull planes (Unitree A1's trunk: 3,158) and tens of thousands of vertices to place, and the whole
+    # product in float64 was most of judging it (3.0 s a call); blocks that stay in cache, in float32, take 0.9 s,
+    # 6e-8 m from it (the allowances this feeds are 1e-4 m and up).
+    centre = vertices.mean(axis=0)
+    normals = planes[:, :3].T.astype(np.float32)
+    offsets = (planes[:, 3] + centre @ planes[:, :3].T).astype(np.float32)
+
+    def distance(points):
+        points = np.asarray(points, dtype=np.float64) - centre
+        found = np.empty(len(points))
+        for start in range(0, len(points), _BLOCK):
+            found[start:start + _BLOCK] = (points[start:start + _BLOCK].astype(np.float32) @ normals + offsets).max(axis=1)
+        return np.maximum(found, 0.0)
+    return distance
+
+
+#: points a block in :func:`_hull`'s distance (a block times the planes stays in cache)
+_BLOCK = 2048
 
 
 @dataclass
@@ -222,6 +239,11 @@ def place(reference: np.ndarray, shapes, inertial_position, *, tolerance: Tolera
     def allowance(half) -> float:
         return tolerance.bounds_rtol * 2 * float(np.max(half)) + 1e-9
 
+    # A drawing is right when it is *any* of the shapes of its size in the right place: a frame may have
+    # several shapes of one size (the Minitaur's base: two identical boxes at y = ±0.1; R2-D2's merged
+    # links), and the drawing of one must not be judged against its twin. So every shape of the drawing's
+    # size is tried before any is said to be missed, and a miss is told against the nearest of them.
+    sized = []
     for what, which, centre, half in shapes_of:
         room = allowance(half)
         if not np.all(np.abs(drawn_half - half) <= room):
@@ -233,16 +255,23 @@ def place(reference: np.ndarray, shapes, inertial_position, *, tolerance: Tolera
         slack = room + np.maximum(half - drawn_half, 0.0)
         if np.all(np.abs(offset) <= slack):
             return Placement(True, True, f"on {what}", shape=which)
+        sized.append((float(np.linalg.norm(offset)), what, which, centre, room, offset, slack))
+    if sized:
         inertial = np.asarray(inertial_position, dtype=np.float64)
-        diagnosis = ""
-        if np.linalg.norm(inertial) > room:
-            if np.all(np.abs(offset - inertial) <= room):
-                diagnosis = "com-frame"
-            elif np.all(np.abs(offset - 2 * inertial) <= room) or np.all(np.abs(offset + inertial) <= room):
-                diagnosis = "offset-sign"
-        for mistake, m_centre, m_half in _mistakes(visuals):
-            if not diagnosis and np.all(np.abs(m_half - drawn_half) <= room) and np.all(np.abs(m_centre - drawn_centre) <= room):
-                diagnosis = mistake
+        told = []  # (diagnosis, shape) for each shape of the drawing's size, nearest first
+        for _, what, which, centre, room, offset, slack in sorted(sized, key=lambda entry: entry[0]):
+            diagnosis = ""
+            if np.linalg.norm(inertial) > room:
+                if np.all(np.abs(offset - inertial) <= room):
+                    diagnosis = "com-frame"
+                elif np.all(np.abs(offset - 2 * inertial) <= room) or np.all(np.abs(offset + inertial) <= room):
+                    diagnosis = "offset-sign"
+            for mistake, m_centre, m_half in _mistakes(visuals):
+                if not diagnosis and np.all(np.abs(m_half - drawn_half) <= room) and np.all(np.abs(m_centre - drawn_centre) <= room):
+                    diagnosis = mistake
+            told.append((diagnosis, what, which, centre, offset, slack))
+        # the shape a known mistake explains, else the nearest
+        diagnosis, what, which, centre, offset, slack = next((t for t in told if t[0]), told[0])
         axis = int(np.argmax(np.abs(offset) - slack))
         return Placement(True, False, f"drawn {np.linalg.norm(offset):.4g} m off {what} (drawn centre "
                          f"{_v(drawn_centre)} in the link frame, the shape's {_v(centre)}; allowed {slack[axis]:.3g} m "

@@ -126,7 +126,8 @@ def _frame(d: dict) -> Frame:
     shapes = tuple((s[0], tuple(s[1]), tuple(s[2]), tuple(s[3])) for s in d["shapes"])
     return Frame(d["client"], d["body"], d["link"], d["name"], d["mass"], shapes, tuple(d.get("inertial", (0.0, 0.0, 0.0))),
                  tuple(tuple(v) for v in d.get("mesh", ())),
-                 tuple((v[0], tuple(v[1]), tuple(v[2]), tuple(v[3]), tuple(tuple(q) for q in v[4])) for v in d.get("visuals", ())), d.get("node", -1))
+                 tuple((v[0], tuple(v[1]), tuple(v[2]), tuple(v[3]), tuple(tuple(q) for q in v[4])) for v in d.get("visuals", ())), d.get("node", -1),
+                 d.get("shown", -1))
 
 
 def load(path) -> Recording:
