@@ -147,11 +147,28 @@ def test_bodies_that_move_together_hold_each_others_vertices_and_a_right_drawing
 
 
 def test_a_decoration_near_its_body_is_not_judged_and_passes():
-    """A box drawn half again as large as its collision box, around it: another shape, not judged."""
+    """A box drawn half again as large as its collision box, around it, beside a drawing of the box (a halo):
+    another shape, not judged; and a decoration of another shape is not judged even where it is the body's
+    only drawing."""
     pos, orn = motion()
-    verdicts = judge(recording([box_frame()], [(pos, orn)], [track(draw(pos, orn, CORNERS * 1.5))]))
-    assert _failing(verdicts) == set()
-    assert any("not judged" in note for note in verdicts["placed"].notes)
+    halo = [track(draw(pos, orn)), track(draw(pos, orn, CORNERS * 1.5), label="halo")]
+    flag = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 0.3], [0.02, 0.0, 0.3], [0.0, 0.03, 0.25]])  # a pennant on a pole
+    for tracks in (halo, [track(draw(pos, orn, flag), label="pennant")]):
+        verdicts = judge(recording([box_frame()], [(pos, orn)], tracks))
+        assert _failing(verdicts) == set(), {k: v.message() for k, v in verdicts.items() if not v.passed}
+        assert any("not judged" in note for note in verdicts["placed"].notes)
+
+
+@pytest.mark.parametrize("scale", [1.6, 1 / 1.6, 2.56])
+def test_a_body_drawn_only_at_a_scaled_size_is_placed_wrong(scale):
+    """Issue 47: a scale applied twice or left out (globalScaling, a mesh scale) draws every part of a body by
+    one factor; where nothing draws the body at its size, the picture is not pyBullet's: placed fails,
+    states the factor and names the mistake."""
+    pos, orn = motion()
+    verdicts = judge(recording([box_frame()], [(pos, orn)], [track(draw(pos, orn, CORNERS * scale))]))
+    assert _failing(verdicts) == {"placed"}, {k: v.message() for k, v in verdicts.items() if not v.passed}
+    assert f"drawn at {scale:.3g} times the size of its collision shape (box)" in verdicts["placed"].message()
+    assert verdicts["placed"].diagnoses == ["scaled"]
 
 
 def test_one_shared_actor_wrong_for_every_body_gets_one_line_per_body_and_nothing_else():

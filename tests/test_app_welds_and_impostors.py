@@ -75,11 +75,13 @@ def _impostors(radius: float, drawn_radius: float):
 
 def test_an_impostor_sphere_is_placed_as_the_sphere_it_draws():
     """Six vertices at the centre span nothing: judged as points they were 'not the collision shape';
-    with their radius they are the ball, and one twice its size is not."""
+    with their radius they are the ball, and one twice its size, the ball's only drawing, is the ball drawn
+    at the wrong size."""
     right = judge(_impostors(0.2, 0.2), checks=("attached", "placed", "normals"))
     assert all(v.passed for v in right.values()) and not right["placed"].notes, right["placed"].notes
     twice = judge(_impostors(0.2, 0.4), checks=("attached", "placed"))["placed"]
-    assert any("not judged: the drawn shape (half extents (0.4, 0.4, 0.4))" in note for note in twice.notes), twice.notes
+    assert not twice.passed and twice.diagnoses == ["scaled"], twice.message()
+    assert "drawn at 2 times the size of its collision shape (sphere) (half extents (0.4, 0.4, 0.4)" in twice.message()
 
 
 def test_a_note_names_the_ranges_a_frame_holds_not_one_range_over_them():

@@ -488,6 +488,9 @@ class _Judgement:
     def placed(self) -> Verdict:
         verdict = Verdict("placed", True)
         soft: dict[tuple, list] = {}
+        # A frame some drawing shows at its size may carry others (a halo, a marker): those are decorations.
+        # One drawn only at another size, every part scaled by one factor, is drawn at the wrong size.
+        at_its_size = {frame for _, _, frame, _, result in self.placements() if result.judged}
         for track, a, frame, rows, result in self.placements():
             info = self.r.frames[frame]
             if info.node >= 0:
@@ -495,7 +498,12 @@ class _Judgement:
                     (rows, frame, soft_bodies.off_node(self, a.reference[rows], frame)))
                 continue
             where = f"{track.label} vertices {vertex_ranges(rows)} held by {info.label}"
-            if not result.judged:
+            # A welded frame holds what lies on its shape of its weld's drawings, a part, not a drawing of its own.
+            if not result.judged and result.scale and frame not in at_its_size and self.welds[frame] < 0:
+                verdict.passed = False
+                verdict.lines.append(f"{where}: {result.why.removeprefix('not judged: ')}, and nothing draws it at its size")
+                verdict.diagnosed("scaled")
+            elif not result.judged:
                 verdict.notes.append(f"{where}: {result.why}")
             elif not result.ok:
                 verdict.passed = False

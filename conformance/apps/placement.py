@@ -166,6 +166,9 @@ class Placement:
     #: which of the frame's shapes the drawing is: "collision", "visual" (one of its visual shapes, or all
     #: of them together), or "" (not judged)
     shape: str = ""
+    #: a drawing not judged that is one of the shapes uniformly scaled by this factor (0: none): wrong when
+    #: nothing draws its frame at its size (:meth:`~conformance.apps.judge.Judgement.placed` decides)
+    scale: float = 0.0
 
 
 def _box(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -285,6 +288,15 @@ def place(reference: np.ndarray, shapes, inertial_position, *, tolerance: Tolera
         if np.all(np.abs(np.sort(drawn_half) - np.sort(half)) <= allowance(half)):
             return Placement(True, False, f"drawn turned in its frame: half extents {_v(drawn_half)} in the link frame's "
                              f"axes where {what}'s are {_v(half)}", diagnosis="turned-shape", shape=which)
+    # Before the reach: a body drawn 2.56 times its size reaches far, and is not another body's drawing.
+    for what, which, centre, half in shapes_of:
+        scale = _uniform_scale(drawn_half, half, tolerance.bounds_rtol)
+        room = allowance(scale * half) if scale else 0.0
+        # Scaled about the link frame (a globalScaling applied twice scales the visual frame's offset too) or
+        # about the shape's centre (a mesh scale left out).
+        if scale and any(np.all(np.abs(drawn_centre - c) <= room) for c in (scale * centre, centre)):
+            return Placement(False, True, f"not judged: drawn at {scale:.3g} times the size of {what} (half extents "
+                             f"{_v(drawn_half)} where the shape's are {_v(half)})", drawn_centre - centre, "scaled", which, scale)
     what, which, centre, half = shapes_of[0]
     reach = float(np.max(np.linalg.norm(reference - centre, axis=1)))
     limit = REACH * float(np.linalg.norm(half)) + REACH_MARGIN
@@ -295,6 +307,19 @@ def place(reference: np.ndarray, shapes, inertial_position, *, tolerance: Tolera
     known = "; ".join(f"{what}, half extents {_v(half)}" for what, _, _, half in shapes_of)
     return Placement(False, True, f"not judged: the drawn shape (half extents {_v(drawn_half)}) is none of the frame's "
                      f"shapes ({known})")
+
+
+def _uniform_scale(drawn_half: np.ndarray, half: np.ndarray, rtol: float) -> float:
+    """The factor by which ``half`` scaled is ``drawn_half`` along every axis (within ``rtol`` of the
+    largest extent), when it is clearly not 1; else 0. A flat shape (a cloth sheet) is scaled in its plane."""
+    largest = float(np.max(half))
+    if largest <= 0:
+        return 0.0
+    axes = half > 0.05 * largest
+    scale = float(np.median(drawn_half[axes] / half[axes]))
+    if abs(scale - 1) <= 4 * rtol or scale <= 0:
+        return 0.0
+    return scale if np.all(np.abs(drawn_half - scale * half) <= 2 * rtol * scale * largest + 1e-9) else 0.0
 
 
 #: How each mistaken drawing of a visual shape is told.

@@ -25,6 +25,10 @@ DIAGNOSES = {name: text for name, (text, _) in attach_mod.VARIANTS.items()} | {
                     "(getVisualShapeData(body)[i][5:7], the <visual><origin>), which the actor must be moved by",
     "mesh-scale": "drawn without its mesh scale: getVisualShapeData(body)[i][3] (the URDF's <mesh scale>) scales the "
                   "mesh file's vertices",
+    "scaled": "drawn at another size than its shape, every part of it by one factor (the line states it), and "
+              "nowhere at its size: a scale applied twice or left out. loadURDF's globalScaling is already in "
+              "getVisualShapeData's dimensions, mesh scales and frames, and in every pose: scale nothing again; a "
+              "mesh file's vertices take getVisualShapeData(body)[i][3]",
     "stale-normals": "the vertices turn but the stored normals do not: turn normals with the same rotation",
     "unannounced": "vertex data changed without telling the renderer, which keeps drawing the old data: call "
                    "utils.update_actor (FURY 0.12); on FURY 2 call update_range (or update_full) on every buffer "

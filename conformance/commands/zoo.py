@@ -155,7 +155,7 @@ def run(args, extra) -> int:
         sittings.append({"command": made_by, "seconds": round(elapsed), "programs": len(todo) + len(todo_wrong)})
         _write_json(results / "run.json", {"backend": backend, "sittings": sittings})
     beside_outcomes, beside_surveys, beside_sittings = _beside(args.beside)
-    commands = [s["command"] for s in beside_sittings + sittings]
+    commands = [_told(s) for s in beside_sittings + sittings]
     page = table.markdown(outcomes + beside_outcomes, {**beside_surveys, **surveys},
                           made_by="\n".join(commands) or made_by)
     emit(page, args.out)
@@ -188,6 +188,13 @@ def _surveyed(directory: Path) -> dict:
         return dict(json.loads((Path(directory) / "survey.json").read_text(encoding="utf-8")))
     except (OSError, ValueError, TypeError):
         return {}
+
+
+def _told(sitting: dict) -> str:
+    """A sitting's command, with how many programs it judged and in how long where the record says."""
+    told = [f"{sitting['programs']} programs" if "programs" in sitting else "",
+            f"{sitting['seconds'] / 60:.0f} min" if "seconds" in sitting else ""]
+    return sitting["command"] + ("; " + ", ".join(t for t in told if t) if any(told) else "")
 
 
 def _sittings(directory: Path) -> list[dict]:

@@ -115,12 +115,12 @@ MISTAKES = {m.name: m for m in (
             "visual-frame", _visual_order),
     Mistake("mesh-scale", "mesh files drawn without their scale (getVisualShapeData()[3] left out)", "mesh-scale",
             lambda drawing, backend: [(_SCALE, "")]),
-    Mistake("scaling-twice", "globalScaling applied again to shapes pyBullet already scaled", "mesh-scale",
+    Mistake("scaling-twice", "globalScaling applied again to shapes pyBullet already scaled", "scaled",
             lambda drawing, backend: [("    return mesh\n\n\ndef in_link_frame", "    mesh.apply_scale(GLOBAL_SCALING)\n"
                                        "    return mesh\n\n\ndef in_link_frame"),
                                       ("\np.loadURDF(\"plane.urdf\")\n", "\nGLOBAL_SCALING = 1.6\np.loadURDF(\"plane.urdf\")\n")],
             applies=lambda style: style.scaling != 1.0),
-    Mistake("scaling-left-out", "the shapes drawn at the size of the file, globalScaling left out", "mesh-scale",
+    Mistake("scaling-left-out", "the shapes drawn at the size of the file, globalScaling left out", "scaled",
             lambda drawing, backend: [("    return mesh\n\n\ndef in_link_frame", "    mesh.apply_scale(1 / GLOBAL_SCALING)\n"
                                        "    return mesh\n\n\ndef in_link_frame"),
                                       ("\np.loadURDF(\"plane.urdf\")\n", "\nGLOBAL_SCALING = 1.6\np.loadURDF(\"plane.urdf\")\n")],
@@ -148,14 +148,6 @@ LIMITS = {
         "its links only slide (prismatic joints on a static base) and stay turned a half turn about x, to 0.0016 rad: "
         "the transposed rotation is that turn the other way, a constant tilt of 0.0032 rad (0.49 mm at the fingers) "
         "that rigid attachment cannot see and placed's 2.5 % allows, and the kit's events never turn a static base's links",
-    ("cloth_z_up.urdf", "scaling-twice"):
-        "its sheet drawn at 2.56 m where pyBullet's is 1.6 m: placed takes a drawing of another size than every shape "
-        "of its frame for a decoration (the mistaken size it knows is a mesh without its scale), and from the zoo's "
-        "camera the sheet shows its back, which pyBullet's renderer culls, so the pictures compare nothing of it",
-    ("sphere_1cm.urdf", "scaling-left-out"):
-        "its sphere drawn at 5 mm where pyBullet's is 8 mm: placed takes a drawing of another size than every shape of "
-        "its frame for a decoration, and at the zoo's camera the sphere shows only an edge, which the pictures leave "
-        "out (a uniformly scaled drawing as the frame's only one is the mistake to name: issue 48)",
 }
 
 
