@@ -54,6 +54,7 @@ def main(argv: list[str] | None = None) -> int:
     commands = _commands()
     parser = _parser(commands)
     args, extra = parser.parse_known_args(argv)
+    args.argv = list(sys.argv[1:] if argv is None else argv)  # as given: the command line a written page names
     if "--" in extra:  # `kill-rate … -- -k chain`: what follows is pytest's, and "--" itself would end pytest's options
         extra.remove("--")
     command = commands[args.command]

@@ -6,7 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from conformance import validation
-from conformance.commands.common import emit
+from conformance.commands.common import emit, page_header
 from conformance.errors import ConformanceError
 from conformance.validation import argparse_type, file_to_write
 
@@ -59,5 +59,5 @@ def run(args, extra) -> int:
         print(f"{'ok  ' if outcome.agrees else 'DIFF'} {path}: expected {outcome.expected}, got {outcome.verdict()} "
               f"({outcome.seconds:.0f} s)", flush=True)
         outcomes.append(outcome)
-    emit("\n" + examples.table(outcomes, backends.describe()), args.out)
+    emit("\n" + examples.table(outcomes, backends.describe()), args.out, page_header(args))
     return 0 if all(o.agrees for o in outcomes) else 1

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from conformance.commands.common import emit
+from conformance.commands.common import emit, page_header
 from conformance.validation import argparse_type, file_to_write
 
 NAME = "documented"
@@ -16,5 +16,5 @@ def add_arguments(parser) -> None:
 def run(args, extra) -> int:
     from conformance.checks import documented
 
-    emit(documented.table(), args.out)
+    emit(documented.table(), args.out, page_header(args))
     return 0

@@ -4,7 +4,7 @@ which check kills which (:mod:`conformance.discrimination.kill_matrix`)."""
 
 from __future__ import annotations
 
-from conformance.commands.common import add_backend_run_arguments, emit, replace_block
+from conformance.commands.common import add_backend_run_arguments, emit, page_header, replace_block
 from conformance.commands.verdicts import jobs
 from conformance.validation import argparse_type, existing_file, file_to_write, module_name
 
@@ -39,7 +39,7 @@ def run(args, extra) -> int:
     accepted = verdicts.check_all(right, pytest_args=extra, jobs=args.jobs)
     summaries = {spec: verdicts.what_it_is(spec) for spec in wrong + right}
     text = verdicts.kill_rate_table(outcomes, accepted, summaries)
-    emit(f"Checked on the {backends.describe()}.\n\n{text}", args.out)  # which FURY, in every copy
+    emit(f"Checked on the {backends.describe()}.\n\n{text}", args.out, page_header(args))  # which FURY, in every copy
     if args.matrix:
         from conformance.discrimination import kill_matrix
         from conformance.files import write_atomically

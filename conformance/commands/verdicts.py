@@ -6,7 +6,7 @@ of failure it finds with its worst figure, so a table cell is everything a sync 
 
 from __future__ import annotations
 
-from conformance.commands.common import add_backend_run_arguments, emit, replace_block
+from conformance.commands.common import add_backend_run_arguments, emit, page_header, replace_block
 from conformance.validation import MAX_JOBS, argparse_type, existing_file, file_to_write, positive_int
 
 NAME = "verdicts"
@@ -35,7 +35,7 @@ def run(args, extra) -> int:
         sync.load(spec)
     outcomes = verdicts.check_all(args.specs, survey=True, pytest_args=extra, jobs=args.jobs)
     text = verdicts.verdict_tables(outcomes)
-    emit(f"Checked on the {backends.describe()}.\n\n{text}", args.out)  # which FURY, in every copy
+    emit(f"Checked on the {backends.describe()}.\n\n{text}", args.out, page_header(args))  # which FURY, in every copy
     if args.json:
         verdicts.save_run(args.json, outcomes)
     if args.readme:
