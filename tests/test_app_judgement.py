@@ -450,3 +450,34 @@ def test_vertices_drawn_at_nan_fail_attached_and_crash_nothing():
     assert not verdicts["attached"].passed
     assert "box_actor (Mesh) vertices 2:4 of 8: not finite (NaN or infinity) at tick 0" in verdicts["attached"].message()
     assert verdicts["drawn"].passed and verdicts["placed"].passed, (verdicts["drawn"].message(), verdicts["placed"].message())
+
+
+def _playback(drawn: str):
+    """Kinematic playback (issue 48): each tick steps (a sag of 0.2 mm from the last tick's pose), then the app
+    sets the body to its trajectory's pose with a write, then draws. ``drawn``: ``"at the end"`` (right),
+    ``"before its own move"`` (after the step, before the write) or ``"before the step"`` (one step late)."""
+    trajectory, turns = motion()
+    stepped = np.concatenate([trajectory[:1], trajectory[:-1] + [0.0, 0.0, -2e-4]])
+    stepped_turns = np.concatenate([turns[:1], turns[:-1]])
+    drawing = {"at the end": (trajectory, turns), "before its own move": (stepped, stepped_turns),
+               "before the step": (np.concatenate([trajectory[:1], trajectory[:-1]]), stepped_turns)}[drawn]
+    made = recording([box_frame()], [(trajectory, turns)], [track(draw(*drawing))])
+    velocities = np.zeros((len(trajectory), 1, 6))
+    made.writes = np.concatenate([np.concatenate([stepped[:, None], stepped_turns[:, None], velocities], axis=-1),
+                                  np.concatenate([trajectory[:, None], turns[:, None], velocities], axis=-1)], axis=-1)
+    made.writes[0] = np.nan
+    made.writers = [[]] + [["resetBasePositionAndOrientation"]] * TICKS
+    return made
+
+
+@pytest.mark.parametrize("drawn, diagnosis", [("before its own move", "before-own-move"),
+                                              ("before the step", "previous-step")])
+def test_a_drawing_made_before_the_apps_own_move_is_told_from_one_made_before_the_step(drawn, diagnosis):
+    """Issue 48: a sync that runs after the step but before the tick's own resetJointState draws where the step
+    left the body; one that runs before the step draws the last tick's pose. The step moves the body less than
+    the two apart, so both could be said to fit: the nearer names the mistake, and the advice is about the
+    app's own order of calls only for the first."""
+    assert judge(_playback("at the end"))["attached"].passed
+    verdict = judge(_playback(drawn))["attached"]
+    assert not verdict.passed and verdict.diagnoses == [diagnosis], verdict.message()
+    assert ("the app's own moves" in verdict.message()) == (diagnosis == "before-own-move"), verdict.message()

@@ -258,6 +258,9 @@ class _Judgement:
                 piece = rows[s:e]
                 if mistakes[s]:
                     frame, diagnosis = int(frames[s]), list(attach_mod.VARIANTS)[mistakes[s] - 1]
+                    if diagnosis == "previous-step":  # or later than the step: before the app's own moves
+                        diagnosis = self._later_than_the_step(track.vertices[1:, piece], frame, a.reference[piece]) \
+                            or diagnosis
                 else:
                     frame, diagnosis = self._followed(track.vertices[1:, piece], a.frame[piece], a.reference[piece])
                 if pieces and pieces[-1][1] == piece[0] and pieces[-1][2:] == (frame, diagnosis):
@@ -328,6 +331,9 @@ class _Judgement:
     def _diagnose(self, vertices, frame, reference, allowance, bad_ticks) -> str:
         if frame < 0:
             return ""
+        own = self._before_own_move(vertices, frame, reference, allowance, bad_ticks)
+        if own:
+            return own
         possible = self._variants_possible(vertices, frame, reference, allowance, bad_ticks)
         for name, (positions, rotations), could in zip(attach_mod.VARIANTS, self._variants, possible):
             if not could:
@@ -340,6 +346,53 @@ class _Judgement:
                     return "skipped"
                 return name
         return "skipped" if self._skipped(vertices, frame, allowance) else ""
+
+    @functools.cached_property
+    def _poses_before_writes(self) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """Each frame's pose after the tick's last step and before the app's own first write of the tick
+        (positions ``(T, F, 3)``, rotations ``(T, F, 3, 3)``), the pose it drew at ticks without a write that
+        moved it; and ``(T, F)`` where a write moved it. None when the app moved nothing after its steps."""
+        writes = self.r.writes
+        if writes is None or not len(self.pos):
+            return None
+        before = writes[1:len(self.pos) + 1, :, :7]
+        known = np.isfinite(before).all(axis=-1)
+        held = np.where(known[..., None], before, np.concatenate([self.pos, self.orn], axis=-1))
+        # A joint reset may turn a link about its own origin: moved is moved or turned.
+        turned = 1 - np.abs(np.sum(held[..., 3:7] * self.orn, axis=-1)) > 1e-12
+        moved = known & ((np.linalg.norm(self.pos - held[..., :3], axis=-1) > UNTOUCHED_ATOL) | turned)
+        if not moved.any():
+            return None
+        positions = np.where(moved[..., None], held[..., :3], self.pos)
+        rotations = np.where(moved[..., None, None], _rotations(np.where(moved[..., None], held[..., 3:7], self.orn)),
+                             self.rot)
+        return positions, rotations, moved
+
+    def _before_own_move(self, vertices, frame, reference, allowance, bad_ticks) -> str:
+        """``"before-own-move"`` when the vertices sit, at the failing ticks, where the frame was after the step
+        and before the app's own moves of that tick (``resetJointState`` of a playback), closer than at its pose
+        before the step: the sync ran between them. Both may fit when a step moves a body less than the
+        allowance (a kinematic arm): the nearer names the mistake."""
+        before = self._poses_before_writes
+        if before is None or not before[2][:, frame].any() or not len(bad_ticks):
+            return ""
+        positions, rotations, _ = before
+        positions, rotations = positions[:, frame, None], rotations[:, frame, None]
+        if not attach_mod.variant_fit(vertices, positions, rotations, reference, allowance, bad_ticks):
+            return ""
+        late = list(attach_mod.VARIANTS).index("previous-step")
+        late_pos, late_rot = (a[:, frame, None] for a in self._variants[late])
+
+        def worst(pos, rot):
+            local = attach_mod.local_coordinates(vertices[bad_ticks], pos[bad_ticks], rot[bad_ticks])
+            return float(np.max(np.linalg.norm(local - reference, axis=-1)))
+        return "before-own-move" if worst(positions, rotations) < worst(late_pos, late_rot) else ""
+
+    def _later_than_the_step(self, vertices, frame, reference) -> str:
+        """:meth:`_before_own_move` for a piece :meth:`_owners` found a step late."""
+        error, allowance = self._errors(vertices, frame)
+        bad_ticks = np.flatnonzero(np.any(error > allowance[:, None], axis=0))
+        return self._before_own_move(vertices, frame, reference, allowance, bad_ticks)
 
     def _skipped(self, vertices, f, allowance) -> bool:
         """Whether at every tick the vertices sit, in their frame, where they sat at one of the first ticks,

@@ -29,6 +29,9 @@ DIAGNOSES = {name: text for name, (text, _) in attach_mod.VARIANTS.items()} | {
               "nowhere at its size: a scale applied twice or left out. loadURDF's globalScaling is already in "
               "getVisualShapeData's dimensions, mesh scales and frames, and in every pose: scale nothing again; a "
               "mesh file's vertices take getVisualShapeData(body)[i][3]",
+    "before-own-move": "drawn at the pose pyBullet held after the tick's step but before the app's own moves of that "
+                       "tick (resetJointState, resetBasePositionAndOrientation: a playback, a teleport): the sync runs "
+                       "between them; draw after the app's own moves, at the end of the tick",
     "stale-normals": "the vertices turn but the stored normals do not: turn normals with the same rotation",
     "unannounced": "vertex data changed without telling the renderer, which keeps drawing the old data: call "
                    "utils.update_actor (FURY 0.12); on FURY 2 call update_range (or update_full) on every buffer "

@@ -135,7 +135,7 @@ MISTAKES = {m.name: m for m in (
             _tick((_DRAW, "    if cnt % 2 == 0:\n        sync()\n    showm.render()\n"))),
     Mistake("one-step-late", "the actors synced before p.stepSimulation()", "previous-step",
             _tick((_DRAW, "    showm.render()\n"), (_STEP, "    sync()\n" + _STEP))),
-    Mistake("before-reset", "drawn after the step but before the tick's own resetJointState", "",
+    Mistake("before-reset", "drawn after the step but before the tick's own resetJointState", "before-own-move",
             _tick((_DRAW, "    showm.render()\n"), (_STEP, _STEP + "    sync()\n")),
             applies=lambda style: style.drive == "playback"),
 )}
