@@ -481,3 +481,16 @@ def test_a_drawing_made_before_the_apps_own_move_is_told_from_one_made_before_th
     verdict = judge(_playback(drawn))["attached"]
     assert not verdict.passed and verdict.diagnoses == [diagnosis], verdict.message()
     assert ("the app's own moves" in verdict.message()) == (diagnosis == "before-own-move"), verdict.message()
+
+
+def test_a_link_never_posed_left_at_the_origin_is_named_never_moved():
+    """Issue 48: a body whose actor is built in its link frame and never posed (the sync skips it) stays at the
+    world's origin, far from where the body starts: ``drawn`` fails and names it, as for one left where the
+    body started; a drawing of another shape there is not taken for it."""
+    pos, orn = motion(offset=(2.0, 0.0, 0.0))
+    for geometry, named in ((CORNERS, True), (CORNERS * [3.0, 0.2, 1.0], False)):
+        left = np.broadcast_to(geometry, (len(pos),) + geometry.shape).copy()
+        verdict = judge(recording([box_frame()], [(pos, orn)], [track(left)]))["drawn"]
+        assert not verdict.passed, verdict.message()
+        assert (verdict.diagnoses == ["never-moved"]) == named, verdict.message()
+        assert ("at the world's origin, never posed" in verdict.message()) == named, verdict.message()

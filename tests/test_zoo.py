@@ -113,3 +113,20 @@ def test_a_wrong_program_is_held_against_the_right_ones_drawing(tmp_path, monkey
         outcome = judging.judge_wrong(wrong, right, model, style, backends.NAME, mistake, ticks=20)
         assert outcome.outcome == expected, (mistake, outcome)
         assert (outcome.shown > judging.SAME) == (expected == "missed"), outcome
+
+
+@pytest.mark.fury_free("the table from outcomes made by hand")
+def test_the_table_tells_whether_each_rejection_names_its_mistake():
+    """Issue 48's measure on the zoo: a rejection whose diagnoses start with its mistake's is named first, one
+    that has it later is named later, one with none is silent, and one that starts with another is named wrong
+    and counted under the name it got; a right program's rejection is no part of it."""
+    from conformance.zoo import table
+
+    made = [judging.Outcome("m.urdf", "links", "vtk", "rejected", "one-step-late", diagnoses=["previous-step"]),
+            judging.Outcome("n.urdf", "links", "vtk", "rejected", "one-step-late", diagnoses=["never-moved", "previous-step"]),
+            judging.Outcome("o.urdf", "links", "vtk", "rejected", "one-step-late", diagnoses=[]),
+            judging.Outcome("p.urdf", "links", "pygfx", "rejected", "one-step-late", diagnoses=["skipped"]),
+            judging.Outcome("p.urdf", "links", "pygfx", "rejected", "", diagnoses=["skipped"])]
+    page = table.markdown(made, {}, made_by="hand")
+    assert "| one-step-late | `previous-step` | 4 | 1 | 1 | 1 | 1 (skipped 1) |" in page, page
+    assert "Named first: 1 of 4 (25 %); named wrong (another first): 1; none: 1." in page, page

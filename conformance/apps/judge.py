@@ -507,6 +507,12 @@ class _Judgement:
                 points = track.vertices[0, start:stop]
                 distance = float(np.linalg.norm(points.mean(axis=0) - origin))
                 if distance > radius + 0.01:
+                    # Built in the link frame and never posed: the world holds the frame's shape at its origin.
+                    unposed = place(points, info.shapes, self._inertial(index), tolerance=self.tolerance,
+                                    mesh=info.mesh, visuals=info.visuals)
+                    if unposed.judged and unposed.ok:
+                        found.append((True, distance, f"{track.label} vertices {start}:{stop} (at the world's origin, "
+                                      "never posed)"))
                     continue
                 local = (points - origin) @ turn  # in the frame as it was at the start
                 placed = place(local, info.shapes, self._inertial(index), tolerance=self.tolerance, mesh=info.mesh,

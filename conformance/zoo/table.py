@@ -68,7 +68,7 @@ def markdown(outcomes, surveys: dict, *, made_by: str, backends=("vtk", "pygfx")
         diagnosis = f" (diagnosis: {', '.join(o.diagnoses)})" if o.diagnoses else ""
         lines.append(f"- `{o.model}` {o.style}, {FURY[o.backend]}: {o.outcome}: {o.first}{diagnosis}")
     if wrong:
-        lines += ["", *_wrong_table(wrong, ran), "", *_cost(wrong, by_key, ran)]
+        lines += ["", *_wrong_table(wrong, ran), "", *_named(wrong), "", *_cost(wrong, by_key, ran)]
     unusable = sorted((m, s.unusable) for m, s in surveys.items() if s.unusable)
     lines += ["", f"## Models not judged ({len(unusable)})", "",
               "A model that does not load, has nothing to draw or nothing that moves cannot tell a right drawing from a "
@@ -116,6 +116,40 @@ def _wrong_table(wrong, ran) -> list[str]:
     lines += [f"- `{o.model}` {o.style} with {o.mistake}, {FURY[o.backend]}: {o.outcome}"
               + (f", drawn up to {o.shown:.3g} m from the right program" if o.outcome == "missed" else f": {o.first}")
               for o in sorted(missed, key=lambda o: (o.model, o.mistake, o.backend))] or ["None."]
+    return lines
+
+
+def _named(wrong) -> list[str]:
+    """Whether each rejected program's failure names its mistake (issue 48): the diagnosis the mistake should
+    get (``Mistake.diagnosis``) first, later, none, or another first, both FURYs together."""
+    from conformance.zoo.mistakes import MISTAKES
+
+    lines = ["## Mistakes named", "",
+             "What the first failing check's diagnoses say of each rejected program, both FURYs together (each "
+             "program's latest verdict): the mistake's own diagnosis first, later, none at all, or another first "
+             "(named wrong).", "",
+             "| mistake | its diagnosis | rejected | named first | named later | none | another first (which) |",
+             "|---|---|---|---|---|---|---|"]
+    totals = Counter()
+    for name, mistake in MISTAKES.items():
+        mine = [o for o in wrong if o.mistake == name and o.outcome == "rejected"]
+        if not mine:
+            continue
+        count, others = Counter(), Counter()
+        for o in mine:
+            first = o.diagnoses[0] if o.diagnoses else ""
+            cell = ("first" if first == mistake.diagnosis else "later" if mistake.diagnosis in o.diagnoses
+                    else "none" if not first else "other")
+            count[cell] += 1
+            if cell == "other":
+                others[first] += 1
+        totals.update(count)
+        which = ", ".join(f"{k} {v}" for k, v in others.most_common(3))
+        lines.append(f"| {name} | `{mistake.diagnosis or '-'}` | {len(mine)} | {count['first']} | {count['later']} | "
+                     f"{count['none']} | {count['other']}{f' ({which})' if which else ''} |")
+    judged = sum(totals.values()) or 1
+    lines += ["", f"Named first: {totals['first']} of {sum(totals.values())} ({100 * totals['first'] / judged:.0f} %); "
+                  f"named wrong (another first): {totals['other']}; none: {totals['none']}."]
     return lines
 
 
