@@ -15,6 +15,7 @@ import sys
 import tempfile
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import background
@@ -130,3 +131,16 @@ def test_the_table_tells_whether_each_rejection_names_its_mistake():
     page = table.markdown(made, {}, made_by="hand")
     assert "| one-step-late | `previous-step` | 4 | 1 | 1 | 1 | 1 (skipped 1) |" in page, page
     assert "Named first: 1 of 4 (25 %); named wrong (another first): 1; none: 1." in page, page
+
+
+@pytest.mark.fury_free("arrays only")
+def test_the_oracle_sees_what_is_drawn_not_how_its_vertices_are_numbered():
+    """A box turned a half turn about x (a cart drawn with a reordered identity quaternion) puts every corner
+    where another was: the same surface, 0 m apart as drawn, though each vertex moved; a box moved 1 cm is 1 cm
+    apart either way."""
+    corners = np.array([[x, y, z] for x in (-0.25, 0.25) for y in (-0.25, 0.25) for z in (-0.1, 0.1)])
+    right = np.broadcast_to(corners, (3, 8, 3))
+    turned = right * [1.0, -1.0, -1.0]
+    assert np.max(np.linalg.norm(turned - right, axis=-1)) > 0.5
+    assert judging._apart(turned, right) == 0.0
+    assert judging._apart(right + [0.01, 0.0, 0.0], right) == pytest.approx(0.01)

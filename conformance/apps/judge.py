@@ -402,8 +402,19 @@ class _Judgement:
         ticks = len(vertices)
         if ticks < 3:
             return False
+        turns = _rotations(self.r.before_orientations[1:][:, f])
+        # Every vertex must sit so at every tick: one that does not at some tick, under every first tick,
+        # rules the piece out at the cost of one vertex (most pieces of a wrong drawing).
+        if vertices.shape[1]:
+            one = vertices[:, :1]
+            now, before = (attach_mod.in_frame(one, self.pos[:, f], self.rot[:, f]),
+                           attach_mod.in_frame(one, self.r.before_positions[1:][:, f], turns))
+            if not any(np.all((np.linalg.norm(now - now[first], axis=-1) <= allowance[:1])
+                              | (np.linalg.norm(before - now[first], axis=-1) <= allowance[:1]))
+                       for first in range(min(3, ticks))):
+                return False
         now = attach_mod.in_frame(vertices, self.pos[:, f], self.rot[:, f])
-        before = attach_mod.in_frame(vertices, self.r.before_positions[1:][:, f], _rotations(self.r.before_orientations[1:][:, f]))
+        before = attach_mod.in_frame(vertices, self.r.before_positions[1:][:, f], turns)
         for first in range(min(3, ticks)):
             right = np.all(np.linalg.norm(now - now[first], axis=-1) <= allowance, axis=1)
             late = np.all(np.linalg.norm(before - now[first], axis=-1) <= allowance, axis=1)

@@ -119,13 +119,31 @@ def judge_wrong(wrong: Path, right: Path, model: Model, style: Style, backend: s
             if a.vertices.shape != b.vertices.shape:
                 shown = float("inf")
                 break
-            shown = max(shown, float(np.max(np.linalg.norm(a.vertices - b.vertices, axis=-1), initial=0.0)))
+            shown = max(shown, _apart(a.vertices, b.vertices))
     outcome.shown = shown
     outcome.outcome = "missed" if shown > SAME else "no-difference"
     if outcome.outcome == "missed" and (model.path, mistake) in LIMITS:
         outcome.outcome, outcome.first = "limit", LIMITS[(model.path, mistake)]
     outcome.seconds = round(outcome.seconds + time.perf_counter() - start, 2)
     return outcome
+
+
+def _apart(wrong, right) -> float:
+    """How far the drawing ``wrong`` ``(T, n, 3)`` is from ``right`` at its worst tick: vertex by vertex, or,
+    where that differs, as point sets (each vertex's distance to the other drawing's nearest, both ways). A
+    shape turned onto itself (a cart's box turned a half turn by a reordered quaternion) shows the same
+    surface with its vertices renumbered: what the model shows is the set, not the numbering."""
+    import numpy as np
+    from scipy.spatial import cKDTree
+
+    each = float(np.max(np.linalg.norm(wrong - right, axis=-1), initial=0.0))
+    if each <= SAME or not np.isfinite(wrong).all() or not np.isfinite(right).all():
+        return each
+    worst = 0.0
+    for w, r in zip(wrong, right):
+        worst = max(worst, float(np.max(cKDTree(r).query(w)[0], initial=0.0)),
+                    float(np.max(cKDTree(w).query(r)[0], initial=0.0)))
+    return worst
 
 
 def load_journal(paths) -> list[Outcome]:
