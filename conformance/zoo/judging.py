@@ -94,10 +94,8 @@ def judge_wrong(wrong: Path, right: Path, model: Model, style: Style, backend: s
                 ticks: int = TICKS, tolerance=None) -> Outcome:
     """App mode's verdict on the program ``wrong`` (``right`` with ``mistake`` made), as :func:`judge_program`
     gives it; a wrong program accepted is then held against an independent oracle: its drawing against the
-    right program's, vertex by vertex, in its own run and in the perturbed opening. Within :data:`SAME` at
+    right program's (:func:`_apart`), in its own run and in the perturbed opening. Within :data:`SAME` at
     every tick, the mistake changes nothing this model shows ("no-difference"); further, app mode missed it."""
-    import numpy as np
-
     from conformance.apps import launch, perturb, perturbed as perturbed_mod
 
     outcome = judge_program(wrong, model, style, backend, ticks=ticks, tolerance=tolerance)
