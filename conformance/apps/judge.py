@@ -173,7 +173,7 @@ class _Judgement:
             for start, stop, frame, diagnosis in self._loose_pieces(track, a, loose):
                 rows = np.arange(start, stop)
                 error, allowance = self._errors(track.vertices[1:, rows], frame)
-                bad_ticks = np.flatnonzero(np.any(error > allowance[:, None], axis=0))
+                bad_ticks = _bad_ticks(error, allowance)
                 if not len(bad_ticks):
                     # The frame it follows holds it at every tick, within the allowance of the piece's own
                     # reach from that frame: held, and no line may say it left that frame at some tick.
@@ -229,7 +229,7 @@ class _Judgement:
         verdict.passed = False
         self.followed_badly.add(frame)
         error, allowance = a.error[rows], a.allowance[rows]
-        bad_ticks = np.flatnonzero(np.any(error > allowance[:, None], axis=0))
+        bad_ticks = _bad_ticks(error, allowance)
         first, k = int(bad_ticks[0]), int(np.argmax(error.max(axis=0)))
         vertices = track.vertices[1:, rows]
         diagnosis = self._diagnose(vertices, frame, a.reference[rows], allowance, bad_ticks)
@@ -312,7 +312,7 @@ class _Judgement:
         scored = []
         for frame in candidates:
             error, allowance = self._errors(vertices, frame)
-            bad_ticks = np.flatnonzero(np.any(error > allowance[:, None], axis=0))
+            bad_ticks = _bad_ticks(error, allowance)
             diagnosis = self._diagnose(vertices, frame, reference, allowance, bad_ticks)
             if diagnosis:
                 return frame, diagnosis
@@ -391,7 +391,7 @@ class _Judgement:
     def _later_than_the_step(self, vertices, frame, reference) -> str:
         """:meth:`_before_own_move` for a piece :meth:`_owners` found a step late."""
         error, allowance = self._errors(vertices, frame)
-        bad_ticks = np.flatnonzero(np.any(error > allowance[:, None], axis=0))
+        bad_ticks = _bad_ticks(error, allowance)
         return self._before_own_move(vertices, frame, reference, allowance, bad_ticks)
 
     def _skipped(self, vertices, f, allowance) -> bool:
@@ -709,6 +709,11 @@ class _Judgement:
         verdict.diagnosed("written-back")
         verdict.worst = float(change[back].max())
         return verdict
+
+
+def _bad_ticks(error: np.ndarray, allowance: np.ndarray) -> np.ndarray:
+    """The ticks (indices) at which some vertex's error ``(m, T)`` is beyond its allowance ``(m,)``."""
+    return np.flatnonzero(np.any(error > allowance[:, None], axis=0))
 
 
 def _attach_finite(vertices: np.ndarray, bad: np.ndarray, *args, **kwargs):
