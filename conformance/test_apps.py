@@ -15,6 +15,7 @@ import pytest
 
 from conformance import apps as app_mode
 from conformance.apps import perturbed
+from conformance.apps.verdict import lead_line
 
 _RUNS: dict = {}
 
@@ -58,7 +59,9 @@ def test_app(app, check, request, pictures):
     verdict = result.verdicts[check]
     kept = _kept(verdict, result, pictures, request) if check == "pictured" else ""
     if not verdict.passed:
-        pytest.fail(f"{check} [app {app}, {result.recording.ticks} ticks]\n{verdict.message()}{kept}\n"
+        lead = lead_line(result.verdicts)
+        pytest.fail(f"{check} [app {app}, {result.recording.ticks} ticks]\n{lead + chr(10) if lead else ''}"
+                    f"{verdict.message()}{kept}\n"
                     f"reproduce: {result.reproduce()}", pytrace=False)
 
 
@@ -75,7 +78,8 @@ def test_app_perturbed(app, request, pictures):
     found = perturbed.search(app, examples=profiles.app_examples(), tolerance=tolerance_from(request.config))
     if found is not None:
         failing = {k: v for k, v in found.verdicts.items() if not v.passed}
-        lines = "\n".join(f"{k}: {v.message()}" for k, v in failing.items())
+        lines = "\n".join([lead_line(found.verdicts)] * bool(lead_line(found.verdicts))
+                           + [f"{k}: {v.message()}" for k, v in failing.items()])
         kept = _kept(found.verdicts["pictured"], found, pictures, request) if "pictured" in failing else ""
         pytest.fail(f"perturbed run of {app} (events as drawn, not shrunk)\n{lines}{kept}\nreproduce: {found.reproduce()}",
                     pytrace=False)

@@ -18,7 +18,7 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 from conformance import scenes
-from conformance.judge import compare
+from conformance.judge import compare, diagnosis
 from conformance.bullet.collisions import (
     FilterMode,
     GroupMask,
@@ -144,8 +144,11 @@ def verify_drawn_overlap(params, implementation) -> None:
         where = context(SCENE, run.scene.params, f"frame {run.frame}", f"sync {implementation.spec!r}")
         assert_interpenetrating(contacts=contacts, distance=abs(x_b - x_a), depth=timeline.depth, where=where)
         inside, distance = compare.drawn_overlap(run.drawing)
-        assert_drawn_overlapping(inside=inside, distance=distance, where=where)
-        assert_vertices_match(compare.compare_vertices(run.drawing, run.frame), run=run, sync=implementation.spec)
+        results = compare.compare_vertices(run.drawing, run.frame)
+        # A pair drawn apart because a known mistake drew its vertices elsewhere is told so (issue 48)
+        explained = diagnosis.diagnose_frame(run, results) if not all(inside.values()) else ""
+        assert_drawn_overlapping(inside=inside, distance=distance, where=where, explained=explained)
+        assert_vertices_match(results, run=run, sync=implementation.spec)
 
 
 @pytest.mark.scene(SCENE)

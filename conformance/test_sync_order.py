@@ -150,21 +150,18 @@ def machine(kit: Kit, scene_name: str) -> type[RuleBasedStateMachine]:
 
         @rule(which=st.integers(0, 1000), offset=strategies.offsets(), orientation=strategies.orientations())
         def teleport(self, which, offset, orientation):
-            event = Teleport(self.run.frame, which, offset, orientation)
-            event.apply(self.run.scene)
+            self.run.apply_event(Teleport(self.run.frame, which, offset, orientation))
             self.changed(f"teleport(body {self.body(which)}, by {_short(offset)}, to {_short(orientation)})")
 
         @rule(which=st.integers(0, 1000), velocity=strategies.offsets(3.0), offset=strategies.offsets(0.05),
               spin=strategies.offsets(20.0))
         def kick(self, which, velocity, offset, spin):
-            event = Kick(self.run.frame, which, velocity, offset, spin)
-            event.apply(self.run.scene)
+            self.run.apply_event(Kick(self.run.frame, which, velocity, offset, spin))
             self.changed(f"kick(body {self.body(which)}, {_short(velocity)} m/s, {_short(spin)} rad/s)")
 
         @rule(which=st.integers(0, 1000), value=st.floats(-3.14, 3.14), orientation=strategies.orientations())
         def reset_joint(self, which, value, orientation):
-            event = JointReset(self.run.frame, which, value, orientation)
-            event.apply(self.run.scene)
+            self.run.apply_event(JointReset(self.run.frame, which, value, orientation))
             self.changed(f"reset_joint(joint #{which}, {value:.3g} or {_short(orientation)})")
 
         @rule(which=st.integers(0, 1000), to_static=st.booleans())

@@ -33,7 +33,10 @@ class DeadReckoning(Baseline):
     unchanged since its last call means no step came in between, so it moves the body on by its
     velocity, ``pos += v·dt`` (dt read once, at start-up), once per such call. Every check that steps
     before each sync sees the exact pose; a second sync without a step draws every moving body a
-    step ahead of pyBullet."""
+    step ahead of pyBullet.
+
+    Diagnosis: -
+    """
 
     def __init__(self, world):
         super().__init__(world)
@@ -59,7 +62,10 @@ class CountsCallsAsSteps(Baseline):
     and a call that finds the pose unchanged while pyBullet says the body moves for a step not yet
     drawn, so it draws the body that motion further along for every such call. Right while every call
     follows a step, or several; a second call without a step draws a moving body a step ahead (and,
-    after a skipped stretch, the whole stretch ahead)."""
+    after a skipped stretch, the whole stretch ahead).
+
+    Diagnosis: -
+    """
 
     def __init__(self, world):
         super().__init__(world)
@@ -86,7 +92,10 @@ class StaticSetAtFrameZero(Baseline):
     base) and, to skip rewriting them every frame, re-places those only when teleported, which it
     recognises as a new pose without velocity (a static body never has any): a body made dynamic later
     (``changeDynamics(mass=…)``) falls with a velocity, so it stays drawn where it was. Static bodies
-    teleported, and every dynamic one, are drawn right."""
+    teleported, and every dynamic one, are drawn right.
+
+    Diagnosis: before-event
+    """
 
     def __init__(self, world):
         super().__init__(world)

@@ -8,11 +8,13 @@ them; ``tests/test_soft_bodies.py`` runs them there.
 
 from __future__ import annotations
 
+import numpy as np
+
 from conformance.bullet import truth
 from conformance.implementations.frames import SoftBodies
 from conformance.implementations.reference import ReferenceSync
 
-__all__ = ["CopiedOnce", "MovesTheCloth", "NodesReversed", "OneStepLateNodes"]
+__all__ = ["CopiedOnce", "Float16Nodes", "MovesTheCloth", "NodesReversed", "OneStepLateNodes", "PartlyCopied"]
 
 
 class _LateNodes(SoftBodies):
@@ -24,7 +26,10 @@ class _LateNodes(SoftBodies):
 
 class OneStepLateNodes(ReferenceSync):
     """Wrong: keeps each frame's nodes to draw at the next ("read now, draw next frame"), so the cloth is one
-    step behind pyBullet — what a timer callback draws when it copies before stepSimulation."""
+    step behind pyBullet — what a timer callback draws when it copies before stepSimulation.
+
+    Diagnosis: previous-step
+    """
 
     soft_bodies = _LateNodes
 
@@ -36,7 +41,10 @@ class _Reversed(SoftBodies):
 
 class NodesReversed(ReferenceSync):
     """Wrong: copies the nodes in another order than the faces expect (reversed), so every triangle joins
-    the wrong nodes though the cloth's outline looks nearly right."""
+    the wrong nodes though the cloth's outline looks nearly right.
+
+    Diagnosis: node-order
+    """
 
     soft_bodies = _Reversed
 
@@ -50,16 +58,60 @@ class _Once(SoftBodies):
 
 class CopiedOnce(ReferenceSync):
     """Wrong: copies the nodes at the first call only ("the mesh is set up once"), so the soft body stays
-    drawn as it was built while pyBullet's sags and bounces."""
+    drawn as it was built while pyBullet's sags and bounces.
+
+    Diagnosis: never-moved
+    """
 
     soft_bodies = _Once
 
 
 
 
+class _Half(SoftBodies):
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.kept = {}
+
+    def vertices(self, t, nodes):
+        # The first half of the nodes copied each call; the rest kept as first copied (the loop's bound is
+        # another mesh's count)
+        first = self.kept.setdefault(t.name, nodes[t.nodes].copy())
+        half = len(t.nodes) // 2
+        return np.concatenate([nodes[t.nodes][:half], first[half:]])
+
+
+class PartlyCopied(ReferenceSync):
+    """Wrong: copies only the first half of the nodes at every call ("the loop bound came from the other mesh"),
+    so half the soft body follows pyBullet and the other half stays as built.
+
+    Diagnosis: part-copied
+    """
+
+    soft_bodies = _Half
+
+
+class _Float16(SoftBodies):
+    def vertices(self, t, nodes):
+        return nodes[t.nodes].astype(np.float16)
+
+
+class Float16Nodes(ReferenceSync):
+    """Wrong: keeps the soft body's vertices in float16 ("half the memory for a big cloth"), so every node is
+    drawn rounded to 11 bits, up to a millimetre off at two metres.
+
+    Diagnosis: float16
+    """
+
+    soft_bodies = _Float16
+
+
 class MovesTheCloth(ReferenceSync):
     """Wrong: draws right, then writes the soft bodies' nodes back into pyBullet (``resetMeshData``), 1 µm
-    higher, to "keep the drawing and the physics together": a sync must only read."""
+    higher, to "keep the drawing and the physics together": a sync must only read.
+
+    Diagnosis: -
+    """
 
     def __call__(self):
         super().__call__()

@@ -471,6 +471,9 @@ class ExampleVertexRanges:
         rot_mat = np.reshape(p.getMatrixFromQuaternion(p.getDifferenceQuaternion(orn, orns[index])), (3, 3))
         vertices[index * sec: index * sec + sec] = \
             (vertices[index * sec: index * sec + sec] - centers[index]) @ rot_mat + pos
+        normals = self.normal_view(t.actor)
+        if normals is not None:  # turned with the same range and rotation: the ranges are the only mistake
+            normals[index * sec: index * sec + sec] = normals[index * sec: index * sec + sec] @ rot_mat
         centers[index] = pos
         orns[index] = orn
 
@@ -489,6 +492,9 @@ class StaleCentre:
         vertices = self.vertex_view(t.actor)
         delta = np.reshape(self.p.getMatrixFromQuaternion(self.p.getDifferenceQuaternion(orn, self.orns[t.name])), (3, 3))
         vertices[t.start:t.stop] = (vertices[t.start:t.stop] - self.centers[t.name]) @ delta + pos
+        normals = self.normal_view(t.actor)
+        if normals is not None:  # turned right: the stale centre is the only mistake
+            normals[t.start:t.stop] = normals[t.start:t.stop] @ delta
         self.orns[t.name] = orn  # ... and no self.centers[t.name] = pos
 
 
@@ -510,6 +516,10 @@ class Float32Steps:
     def __call__(self):
         actors = {}
         for t in self.targets:
+            if t.nodes is not None:  # a soft body's vertices are its nodes, copied (in float32 too): no pose to step
+                self.vertices[id(t.actor)][t.start:t.stop] = soft_nodes(self.p, t.body)[t.nodes]
+                actors[id(t.actor)] = t.actor
+                continue
             pos, orn = self.link_pose(t)
             pos, orn = np.asarray(pos, np.float32), np.asarray(orn, np.float32)
             old_pos, old_orn = self.last[t.name]

@@ -9,6 +9,7 @@ from scipy.spatial.transform import Rotation
 
 from app_recordings import CORNERS, TICKS, box_frame, draw, motion, recording, track
 from conformance.apps import judge, placement
+from conformance.apps.bodies import Frame
 
 
 def _failing(verdicts):
@@ -33,6 +34,8 @@ def test_float32_storage_is_within_the_allowance():
     ("wxyz", "attached", "wxyz"),
     ("scalar-first", "attached", "scalar-first"),
     ("translation-only", "attached", "translation-only"),
+    ("radians-as-degrees", "attached", "radians-as-degrees"),  # RotateWXYZ(angle in radians, *axis)
+    ("euler-as-degrees", "attached", "radians-as-degrees"),    # from_euler("xyz", pyBullet's angles, degrees=True)
     ("never-moved", "drawn", "never-moved"),
     ("unannounced", "announced", "unannounced"),
     ("jitter", "attached", None),
@@ -50,6 +53,10 @@ def test_a_known_mistake_fails_with_its_diagnosis(mistake, check, diagnosis):
         drawn = draw(pos, Rotation.from_quat(orn, scalar_first=True).as_quat())
     elif mistake == "translation-only":
         drawn = draw(pos, np.tile(orn[:1], (len(orn), 1)))
+    elif mistake == "radians-as-degrees":
+        drawn = draw(pos, Rotation.from_rotvec(Rotation.from_quat(orn).as_rotvec(), degrees=True).as_quat())
+    elif mistake == "euler-as-degrees":
+        drawn = draw(pos, Rotation.from_euler("xyz", Rotation.from_quat(orn).as_euler("xyz"), degrees=True).as_quat())
     elif mistake == "never-moved":
         drawn = draw(np.tile(pos[:1], (len(pos), 1)), np.tile(orn[:1], (len(orn), 1)))
     elif mistake == "unannounced":
@@ -494,3 +501,50 @@ def test_a_link_never_posed_left_at_the_origin_is_named_never_moved():
         assert not verdict.passed, verdict.message()
         assert (verdict.diagnoses == ["never-moved"]) == named, verdict.message()
         assert ("at the world's origin, never posed" in verdict.message()) == named, verdict.message()
+
+
+def test_a_link_never_posed_lying_on_the_ground_is_named_never_moved_and_not_the_grounds_drawing():
+    """A link left at the world's origin, where the ground plate is, lies partly in the plate's shape: the
+    plate holds those vertices as the world holds the rest. ``drawn`` names the link never moved, and
+    ``placed`` does not judge them as the plate drawn at a thousandth of its size (the zoo's KUKA, one link
+    never synced, whose disc lay on the plane)."""
+    pos, orn = motion(offset=(2.0, 0.0, 0.0))
+    half = np.array([0.1, 0.1, 0.005])  # the plate's shape, a thousand times smaller
+    disc = Frame(0, 0, -1, "disc", 1.0, (("box", tuple(2 * half), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0)),), (0.0, 0.0, 0.0))
+    plate = Frame(0, 1, -1, "plate", 0.0, (("box", (200.0, 200.0, 10.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0)),),
+                  (0.0, 0.0, 0.0))
+    still = (np.zeros_like(pos), np.tile([0.0, 0.0, 0.0, 1.0], (len(pos), 1)))
+    corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=float) * half
+    left = np.broadcast_to(corners, (len(pos),) + corners.shape).copy()
+    verdicts = judge(recording([disc, plate], [(pos, orn), still], [track(left)]))
+    assert verdicts["drawn"].diagnoses == ["never-moved"], verdicts["drawn"].message()
+    assert verdicts["placed"].passed, verdicts["placed"].message()
+
+
+def test_a_drawing_a_tick_late_is_named_where_a_tick_steps_several_times():
+    """A tick of four steps drawn at the previous tick's pose (synced before the tick's steps) is at no pose of
+    a step before the last: it is named a tick late (``previous-step``), as one step late is (issue 48: a chain
+    drawn one frame of four steps late was 100 unnamed pieces)."""
+    fine_pos, fine_orn = motion(TICKS * 4)
+    pos, orn = fine_pos[::4], fine_orn[::4]
+    # pyBullet's pose just before each tick's last step, one frame: (T+1, 1, 3), (T+1, 1, 4)
+    before = (np.concatenate([fine_pos[:1], fine_pos[3::4]])[:, None], np.concatenate([fine_orn[:1], fine_orn[3::4]])[:, None])
+    late = draw(np.concatenate([pos[:1], pos[:-1]]), np.concatenate([orn[:1], orn[:-1]]))
+    verdict = judge(recording([box_frame()], [(pos, orn)], [track(late)], before=before))["attached"]
+    assert not verdict.passed and verdict.diagnoses == ["previous-step"], verdict.message()
+
+
+def test_a_change_announced_outside_its_range_is_named_stale_gpu_and_one_never_announced_unannounced():
+    """FURY 2 announces by range: a tick whose announcement misses what changed leaves the GPU's copy stale
+    (``stale-gpu``, as the picture names it); a change with nothing announced is ``unannounced`` (issue 48: the
+    pygfx example announcing its last brick alone was named unannounced)."""
+    pos, orn = motion()
+    partly = track(draw(pos, orn))
+    partly.missed = [(3, "its positions changed at vertices 0–7, outside every range announced on them")]
+    verdict = judge(recording([box_frame()], [(pos, orn)], [partly]))["announced"]
+    assert not verdict.passed and verdict.diagnoses == ["stale-gpu"], verdict.message()
+    for never in (track(draw(pos, orn), announced=np.zeros(len(pos), dtype=bool)), track(draw(pos, orn))):
+        never.missed = never.missed or [(3, "its positions changed at vertices 0–7, with nothing announced on them")]
+        verdict = judge(recording([box_frame()], [(pos, orn)], [never]))["announced"]
+        assert not verdict.passed and verdict.diagnoses == ["unannounced"], verdict.message()
+

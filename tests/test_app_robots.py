@@ -66,18 +66,51 @@ def test_a_link_drawn_off_its_visual_shape_fails_with_the_mistake_named(offset, 
     assert placed.diagnoses == ([diagnosis] if diagnosis else []), placed.lines
 
 
+def test_a_visual_shape_without_its_frame_at_its_centre_of_mass_is_named_by_its_frame():
+    """A bob whose <inertial> and <visual> share their <origin>: drawn without its visual frame it is also off by
+    minus the inertial offset, which the offset turned round would draw too; the visual frame is named (the
+    zoo's pendulum5.urdf and cartpole.urdf were named offset-sign)."""
+    origin = ((0.0, 0.0, -0.3), IDENTITY)
+    frame = Frame(0, 0, 3, "bob", 1.0, (("mesh", (1.0, 1.0, 1.0), (0.0, 0.0, 0.0), IDENTITY),), origin[0],
+                  visuals=(_visual("box", LEG, origin, _primitive_points("box", LEG)),))
+    assert _drawn(frame, _primitive_points("box", LEG) + origin[0]).passed
+    placed = _drawn(frame, _primitive_points("box", LEG))
+    assert not placed.passed and placed.diagnoses == ["visual-frame"], placed.lines
+
+
+def test_a_visual_frame_composed_the_wrong_way_round_is_named():
+    """A shape actor given ``visual_frame @ link_frame`` (the two matrices multiplied in the wrong order) sits
+    right only while the link's pose is the identity: ``attached`` names the visual frame."""
+    poses = rec.motion()
+    shape = _primitive_points("box", LEG)  # the shape in its own (visual) frame
+    p_v, r_v = np.asarray(LEG_FRAME[0]), Rotation.from_quat(LEG_FRAME[1]).as_matrix()
+    r_l = Rotation.from_quat(poses[1]).as_matrix()
+    wrong = np.einsum("ij,tjk,nk->tni", r_v, r_l, shape) + (poses[0] @ r_v.T + p_v)[:, None, :]
+    recording = rec.recording([_leg_frame()], [poses], [rec.track(wrong, label="leg_actor")])
+    verdict = judge(recording, checks=("attached",))["attached"]
+    assert not verdict.passed and verdict.diagnoses == ["visual-frame"], verdict.lines
+    right = rec.draw(*poses, _leg_in_link_frame())
+    assert judge(rec.recording([_leg_frame()], [poses], [rec.track(right, label="leg_actor")]), checks=("attached",))["attached"].passed
+
+
 def test_a_visual_shape_drawn_without_its_frame_is_named():
     placed = _drawn(_leg_frame(), _leg_in_link_frame(framed=False))
     assert not placed.passed and placed.diagnoses == ["visual-frame"], placed.lines
 
 
-def test_a_mesh_drawn_without_its_scale_is_named():
-    """A gear modelled in millimetres, which the URDF scales by 0.001, drawn a thousand times too large."""
+@pytest.mark.parametrize("scale, diagnosis", [
+    # A gear modelled in millimetres, which the URDF scales by 0.001, drawn a thousand times too large: one
+    # factor, which is also what loadURDF's globalScaling left out draws (pyBullet keeps it in the mesh scale).
+    ((0.001, 0.001, 0.001), "scaled"),
+    ((0.001, 0.002, 0.0005), "mesh-scale"),  # a scale that differs by axis is the mesh's own
+])
+def test_a_mesh_drawn_without_its_scale_is_named(scale, diagnosis):
     gear = _primitive_points("box", (30.0, 10.0, 30.0))  # the mesh file's extreme points, in millimetres
-    frame = _leg_frame((_visual("mesh", (0.001, 0.001, 0.001), ((0.0, 0.0, 0.0), IDENTITY), gear * 0.001),))
-    assert _drawn(frame, gear * 0.001).passed
+    frame = _leg_frame((_visual("mesh", scale, ((0.0, 0.0, 0.0), IDENTITY), gear * scale),))
+    assert _drawn(frame, gear * scale).passed
     placed = _drawn(frame, gear)
-    assert not placed.passed and placed.diagnoses == ["mesh-scale"], placed.lines
+    assert not placed.passed and placed.diagnoses == [diagnosis], placed.lines
+    assert ("at 1000 times its size: its mesh scale 0.001" in placed.lines[0]) == (diagnosis == "scaled"), placed.lines
 
 
 # -- the rotation mistakes a robot's links show: angle-axis in degrees, pyBullet's float32 angle-axis ------
@@ -176,3 +209,32 @@ def test_a_body_left_unsynced_is_blamed_on_its_own_drawing_not_a_decoration_besi
     verdict = judge(rec.recording([rec.box_frame()], [(positions, orientations)], tracks), checks=("attached", "drawn"))["drawn"]
     assert not verdict.passed and "bead_actors[9] vertices 0:8 stays where it was built" in verdict.lines[0], verdict.lines
     assert verdict.diagnoses == ["never-moved"]
+
+
+def test_pybullets_euler_angles_are_computed_as_pybullet_computes_them():
+    """The Euler form of radians-as-degrees shrinks pyBullet's own angles, which split a turn at a pitch of ±90°
+    otherwise than scipy's ``as_euler`` (the kit's perturbed runs turn bodies there: a soccer ball drawn with
+    ``from_euler('xyz', getEulerFromQuaternion(q), degrees=True)`` went unnamed)."""
+    import pybullet
+
+    from conformance.apps.attachment import pybullet_euler
+
+    rng = np.random.default_rng(3)
+    turns = [Rotation.random(500, random_state=4).as_quat()]
+    turns += [Rotation.from_euler("xyz", [[rng.uniform(-3, 3), pitch, rng.uniform(-3, 3)] for _ in range(20)]).as_quat()
+              for pitch in (np.pi / 2, -np.pi / 2, np.pi / 2 - 1e-4)]
+    quaternions = np.concatenate(turns + [[[0.5773502691896258, 0.5773502691896258, 0.5773502691896258, 6.1e-17]]])
+    expected = np.array([pybullet.getEulerFromQuaternion(q) for q in quaternions.tolist()])
+    assert np.max(np.abs(pybullet_euler(quaternions) - expected)) < 1e-12
+
+
+def test_an_actor_per_visual_shape_never_posed_is_named_never_moved():
+    """A body dropped from 10 cm above the world's origin, drawn by an actor built in its visual shape's own
+    frame (posed each tick by ``link @ visual``) that the sync skips: the actor stays at the origin, the shape
+    without its visual frame. ``drawn`` names it never moved (the zoo's lego and domino, one shape never synced)."""
+    positions, orientations = rec.motion(offset=(0.0, 0.0, -1.9))  # starts 10 cm above the origin
+    shape = _primitive_points("box", LEG)
+    left = np.broadcast_to(shape, (len(positions),) + shape.shape).copy()
+    recording = rec.recording([_leg_frame()], [(positions, orientations)], [rec.track(left, label="shape_actor")])
+    drawn = judge(recording, checks=("attached", "drawn"))["drawn"]
+    assert not drawn.passed and drawn.diagnoses == ["never-moved"], drawn.lines

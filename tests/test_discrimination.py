@@ -26,11 +26,13 @@ from pathlib import Path
 import pytest
 
 import background
+import confusion_records
 import order_syncs
 import right_syncs
 import wrong_syncs
 from conformance import scenes
-from conformance.discrimination import verdicts
+from conformance.discrimination import confusion_cases, verdicts
+from conformance.judge import diagnosis
 
 TESTS = Path(__file__).resolve().parent
 #: The order-dependent mistakes pass every check but the sync-order machine's (``tests/test_order_checks.py``).
@@ -80,6 +82,11 @@ def test_kit_fails_a_wrong_sync(spec):
         f"the kit should fail the wrong sync {spec} (exit 1), but {_describe(outcome, True)}")
     where = [m for r in outcome.failed for m in WHERE.finditer(r["message"]) if m["scene"] in scenes.names()]
     assert where, f"the failure of {spec} does not name a scene and frame as '[scene(params), frame N': {_describe(outcome, True)}"
+    # Issue 48: the mistake the first failure names, held to the committed confusion record
+    first = outcome.failed[0]
+    confusion_records.assert_named_no_worse("syncs", spec, actual=diagnosis.name_of(first.get("diagnosis") or ""),
+                                            expected=confusion_cases.expected_of(spec),
+                                            where=f"{first['check']} [{first.get('scene')}]")
 
 
 @pytest.mark.parametrize("spec", [pytest.param(s, id=s.partition(":")[2]) for s in RIGHT])

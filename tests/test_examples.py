@@ -13,8 +13,10 @@ from pathlib import Path
 
 import pytest
 
+import confusion_records
 from conformance import backends
 from conformance.apps import examples
+from conformance.apps.verdict import lead
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples" / backends.NAME
 APPS = sorted(p for p in EXAMPLES.rglob("*.py") if not p.name.startswith("_"))
@@ -32,3 +34,7 @@ def test_example_gets_the_verdict_it_states(app):
     outcome = examples.judge_example(app, perturbed=runs)
     assert outcome.agrees, (f"{app}: expected {outcome.expected}, got {outcome.verdict()}"
                             + (f"\n{outcome.error}" if outcome.error else ""))
+    if not expected.passes and expected.diagnosis is not None:  # issue 48: the line the report leads with
+        named = lead(d for diagnoses in outcome.failed.values() for d in diagnoses)
+        confusion_records.assert_named_no_worse("apps", app.relative_to(EXAMPLES.parent.parent).as_posix(), actual=named,
+                                                expected=expected.diagnosis, where=outcome.verdict())

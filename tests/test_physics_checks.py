@@ -103,6 +103,13 @@ def test_render_check_fails_when_the_sync_does_not_move_the_bodies():
         filters.verify_drawn_overlap({**CROSSING, "collide": False}, sync.load("wrong_syncs:DoesNothing"))
 
 
+def test_a_pair_drawn_apart_by_a_known_mistake_is_told_which():
+    """The last body never moved (an off-by-one in the loop over bodies) draws the pair apart: the failure
+    names that mistake on its second line (issue 48), as the vertex checks would."""
+    with pytest.raises(Failed, match=r"drawn centre of .*\ndiagnosis: drawn where it was built"):
+        filters.verify_drawn_overlap({**CROSSING, "collide": False}, sync.load("wrong_syncs:SkipsLastTarget"))
+
+
 # -- forces and torques ------------------------------------------------------------------------
 @pytest.mark.parametrize("applied, assumed", [("LINK_FRAME", "WORLD_FRAME"), ("WORLD_FRAME", "LINK_FRAME")])
 def test_force_check_fails_when_the_force_is_applied_in_the_other_frame(applied, assumed):

@@ -68,7 +68,10 @@ WrongVertexRange = _renderer.WrongVertexRange
 
 class TransposedRotation(Baseline):
     """Wrong: reads getMatrixFromQuaternion's nine numbers column-major ("GPU matrices are
-    column-major"), so every body is drawn with the transpose — the inverse — of its rotation."""
+    column-major"), so every body is drawn with the transpose — the inverse — of its rotation.
+
+    Diagnosis: conjugate
+    """
 
     def matrix(self, orn):
         return np.reshape(self.p.getMatrixFromQuaternion(orn), (3, 3), order="F")
@@ -77,7 +80,10 @@ class TransposedRotation(Baseline):
 class QuaternionWXYZ(Baseline):
     """Wrong: unpacks pybullet's (x, y, z, w) quaternion as (w, x, y, z), the order of transforms3d,
     Eigen's constructor and most textbooks, then uses the textbook matrix formula (pygfx's
-    ``local.rotation`` takes x, y, z, w like pybullet; the mistake is in the hand-written helper)."""
+    ``local.rotation`` takes x, y, z, w like pybullet; the mistake is in the hand-written helper).
+
+    Diagnosis: scalar-first
+    """
 
     def matrix(self, orn):
         w, x, y, z = orn
@@ -90,7 +96,10 @@ class QuaternionWXYZ(Baseline):
 
 class ConjugateQuaternion(Baseline):
     """Wrong: takes pybullet's orientation for a world-to-body rotation and inverts it first
-    (``p.invertTransform``'s quaternion, i.e. the conjugate), so bodies turn the wrong way."""
+    (``p.invertTransform``'s quaternion, i.e. the conjugate), so bodies turn the wrong way.
+
+    Diagnosis: conjugate
+    """
 
     def matrix(self, orn):
         _, inverse = self.p.invertTransform([0, 0, 0], orn)
@@ -101,7 +110,10 @@ class ConjugateQuaternion(Baseline):
 
 class LinkCOMFrame(Baseline):
     """Wrong: draws links at getLinkState()[0:2], the link's centre-of-mass frame, instead of [4:6],
-    its URDF link frame (the first two entries look like "the link's position and orientation")."""
+    its URDF link frame (the first two entries look like "the link's position and orientation").
+
+    Diagnosis: com-frame
+    """
 
     def link_pose(self, t):
         if t.link >= 0:
@@ -111,7 +123,10 @@ class LinkCOMFrame(Baseline):
 
 class StaleLinkState(Baseline):
     """Wrong: getLinkState(body, link)[4:6] without computeForwardKinematics=1 (as the guide's
-    sync_joints does): on pybullet 3.2.7 the cached link poses are those of the previous step."""
+    sync_joints does): on pybullet 3.2.7 the cached link poses are those of the previous step.
+
+    Diagnosis: previous-step
+    """
 
     def link_pose(self, t):
         if t.link >= 0:
@@ -122,7 +137,10 @@ class StaleLinkState(Baseline):
 class FirstMultibodyOnly(Baseline):
     """Wrong: reads every link's pose from the first body that has links (the guide's sync_joints
     takes one global ``multibody``; adapted to a scene with several robots, link ``i`` of each is
-    drawn where link ``i`` of the first one is)."""
+    drawn where link ``i`` of the first one is).
+
+    Diagnosis: other-target
+    """
 
     def __init__(self, world):
         super().__init__(world)
@@ -137,7 +155,10 @@ class FirstMultibodyOnly(Baseline):
 class IgnoresBaseInertialFrame(Baseline):
     """Wrong: draws a base at getBasePositionAndOrientation, which is its centre-of-mass frame, not its
     link frame (as the guide does): wrong for any base created with baseInertialFramePosition or
-    Orientation, or loaded from a URDF whose base <inertial> has an <origin>."""
+    Orientation, or loaded from a URDF whose base <inertial> has an <origin>.
+
+    Diagnosis: com-frame
+    """
 
     def link_pose(self, t):
         if t.link == -1:
@@ -150,7 +171,10 @@ class IgnoresBaseInertialFrame(Baseline):
 class OneStepLate(Baseline):
     """Wrong: double-buffers poses ("read now, draw next frame, to overlap physics and rendering"),
     so every frame shows the pose of the step before — what the guide's timer callback draws when it
-    syncs before stepSimulation instead of after."""
+    syncs before stepSimulation instead of after.
+
+    Diagnosis: previous-step
+    """
 
     def __init__(self, world):
         super().__init__(world)
@@ -167,7 +191,10 @@ class OneStepLate(Baseline):
 
 class SkipsLastTarget(Baseline):
     """Wrong: an off-by-one in the loop over bodies (``range(len(targets) - 1)``, written when the last
-    body was the ground plane), so the last body is never moved."""
+    body was the ground plane), so the last body is never moved.
+
+    Diagnosis: never-moved
+    """
 
     def to_sync(self):
         return [self.targets[i] for i in range(len(self.targets) - 1)]
@@ -176,7 +203,10 @@ class SkipsLastTarget(Baseline):
 class StaticPlacedOnce(Baseline):
     """Wrong: places bodies of mass 0 (the ground, walls, a robot's fixed base) on the first frame and
     never again ("static bodies do not move"): a static body moved by resetBasePositionAndOrientation
-    stays drawn where it was."""
+    stays drawn where it was.
+
+    Diagnosis: before-event
+    """
 
     def __init__(self, world):
         super().__init__(world)
@@ -193,7 +223,10 @@ class StaticPlacedOnce(Baseline):
 class VelocityGated(Baseline):
     """Wrong: after the first frame, skips bodies whose velocity is exactly zero ("a body at rest has not
     moved"): but resetBasePositionAndOrientation moves a body and leaves its velocity zero (pybullet
-    3.2.7 zeroes it, and a static body's is always zero), so a teleported body stays drawn where it was."""
+    3.2.7 zeroes it, and a static body's is always zero), so a teleported body stays drawn where it was.
+
+    Diagnosis: before-event
+    """
 
     def __init__(self, world):
         super().__init__(world)
@@ -219,7 +252,10 @@ class VelocityGated(Baseline):
 class WritesPoseBack(Baseline):
     """Wrong: writes the float32-rounded pose it drew back into pybullet with
     resetBasePositionAndOrientation ("so physics and graphics agree exactly"): the sync changes the
-    simulation it is supposed to only watch."""
+    simulation it is supposed to only watch.
+
+    Diagnosis: -
+    """
 
     def __call__(self):
         super().__call__()
@@ -231,7 +267,10 @@ class WritesPoseBack(Baseline):
 
 
 class DoesNothing:
-    """Wrong: never moves anything (a sync function that was written and never wired up)."""
+    """Wrong: never moves anything (a sync function that was written and never wired up).
+
+    Diagnosis: never-moved
+    """
 
     def __init__(self, world):
         pass

@@ -27,7 +27,10 @@ class EulerRotateXYZ(Baseline):
     axes (it pre-multiplies ``local.matrix``), not the actor's own as VTK's RotateX/Y/Z do, giving
     Rx·Ry·Rz, while the angles mean Rz·Ry·Rx: right only for turns about one axis. (The VTK
     mistake's order, roll first, happens to be right on FURY 2, as is ``actor.rotate((roll, pitch,
-    yaw))`` or ``local.euler`` in radians.) Shared actors' vertex ranges are moved correctly."""
+    yaw))`` or ``local.euler`` in radians.) Shared actors' vertex ranges are moved correctly.
+
+    Diagnosis: euler-order
+    """
 
     def place_whole(self, t, pos, orn):
         roll, pitch, yaw = np.degrees(self.p.getEulerFromQuaternion(orn))
@@ -42,7 +45,10 @@ class EulerRotateXYZ(Baseline):
 
 class InflatedAgainstZFighting(sync_steps.InflatedGeometry, Baseline):
     """Wrong: draws every body 0.1 % larger than its collision shape ("so touching bricks do not
-    z-fight"): ``local.scale`` on whole actors, scaled link-frame geometry in shared ones."""
+    z-fight"): ``local.scale`` on whole actors, scaled link-frame geometry in shared ones.
+
+    Diagnosis: -
+    """
 
     def place_whole(self, t, pos, orn):
         super().place_whole(t, pos, orn)
@@ -52,21 +58,27 @@ class InflatedAgainstZFighting(sync_steps.InflatedGeometry, Baseline):
 class WrongVertexRange(sync_steps.ExampleVertexRanges, Baseline):
     """Wrong: FURY's wrecking-ball example bug: the guide's incremental vertex recipe with the vertices
     per object (``sec``) of every shared actor computed from the object count of the first shared
-    actor (the bricks), so the other shared actors (the chain's links) are moved by the wrong ranges."""
+    actor (the bricks), so the other shared actors (the chain's links) are moved by the wrong ranges.
+
+    Diagnosis: never-moved
+    """
 
     def finish(self, actors):
         for actor in actors:
-            actor.geometry.positions.update_full()  # was utils.update_actor(actor)
+            self.announce(actor)  # was utils.update_actor(actor): positions and normals
 
 
 class CentreNotUpdated(sync_steps.StaleCentre, Baseline):
     """Wrong: the guide's incremental single-actor recipe (turn each vertex range about its tracked
     centre by the rotation since last frame, then move it to the new centre) that updates the tracked
-    orientation but forgets ``brick_centers[i] = pos``: every frame turns about a stale centre."""
+    orientation but forgets ``brick_centers[i] = pos``: every frame turns about a stale centre.
+
+    Diagnosis: -
+    """
 
     def place_shared(self, t, pos, orn):
         super().place_shared(t, pos, orn)
-        t.actor.geometry.positions.update_range(t.start, t.stop - t.start)
+        self.announce_range(t)  # positions and normals
 
     def place_soft(self, t):
         super().place_soft(t)
@@ -80,14 +92,20 @@ class Float32Incremental(sync_steps.Float32Steps, Baseline):
     """Wrong: the incremental recipe applied to every actor's vertices (and normals) in float32 (FURY 2
     stores every actor's positions as float32; this keeps all its arrays so "to match the GPU"): each
     frame's rotation since the last one is rounded to float32 and applied to already rounded vertices,
-    so the error random-walks and a body that tumbles for thousands of steps is drawn off its pose."""
+    so the error random-walks and a body that tumbles for thousands of steps is drawn off its pose.
+
+    Diagnosis: -
+    """
 
 
 class NormalsNotRotated(sync_steps.NormalsLeftAsBuilt, Baseline):
     """Wrong: moves the vertices of shared sphere actors but leaves their ``geometry.normals`` as built,
     so a turned sphere is shaded as if lit from where the light was when it was built (pygfx turns
     normals with an actor's world matrix, never with rewritten positions, and never recomputes a
-    normals buffer it was given)."""
+    normals buffer it was given).
+
+    Diagnosis: stale-normals
+    """
 
     def finish(self, actors):
         for actor in actors:
@@ -97,7 +115,10 @@ class NormalsNotRotated(sync_steps.NormalsLeftAsBuilt, Baseline):
 class ForgetsModified(Baseline):
     """Wrong: writes the new vertices into ``geometry.positions.data`` but never calls
     ``update_range``/``update_full``: pygfx does not know the buffer changed and goes on drawing the
-    vertices it uploaded before."""
+    vertices it uploaded before.
+
+    Diagnosis: unannounced
+    """
 
     def finish(self, actors):
         pass
@@ -106,7 +127,10 @@ class ForgetsModified(Baseline):
 class NormalsUnannounced(Baseline):
     """Wrong: turns the normals with the vertices but announces only ``geometry.positions``: pygfx uploads
     each buffer on its own, so the normals on screen stay as they were and a turned sphere is lit as
-    before (the kit's vertex and normals read-back sees the buffers, not what was uploaded)."""
+    before (the kit's vertex and normals read-back sees the buffers, not what was uploaded).
+
+    Diagnosis: unannounced
+    """
 
     def finish(self, actors):
         for actor in actors:
@@ -116,7 +140,10 @@ class NormalsUnannounced(Baseline):
 class AnnouncesLastRangeOnly(Baseline):
     """Wrong: announces one range per shared actor after the loop, with the loop's last target
     (``update_range(t.start, t.stop - t.start)`` dedented one level): every other body's vertices
-    change in a buffer whose changed chunks pygfx is never told about."""
+    change in a buffer whose changed chunks pygfx is never told about.
+
+    Diagnosis: unannounced
+    """
 
     def place_shared(self, t, pos, orn):
         super().place_shared(t, pos, orn)
@@ -137,7 +164,10 @@ class AnnouncesLastRangeOnly(Baseline):
 
 class TintsMovingBodies(Baseline):
     """Wrong: recolours shared-actor bodies by speed while syncing ("to see what moves"): the vertex
-    colours (``geometry.colors``, announced with ``update_range``), which a sync must leave alone, change."""
+    colours (``geometry.colors``, announced with ``update_range``), which a sync must leave alone, change.
+
+    Diagnosis: -
+    """
 
     def place_shared(self, t, pos, orn):
         super().place_shared(t, pos, orn)

@@ -33,7 +33,7 @@ from scipy.spatial.transform import Rotation
 from conformance.bullet import poses
 from conformance.judge.tolerances import DEFAULT, Tolerance
 
-__all__ = ["Attachment", "VARIANTS", "attach", "in_frame", "local_coordinates", "variant_fit"]
+__all__ = ["ALIASES", "Attachment", "VARIANTS", "attach", "in_frame", "local_coordinates", "variant_fit", "visual_order"]
 
 #: nearest frames (by origin, at the first judged tick) tried first for each vertex, then more of
 #: them for a vertex none of those holds, then all of them (so a range following a far body is found)
@@ -451,6 +451,31 @@ def _axis_angle(quaternions: np.ndarray, scale: float = 1.0) -> np.ndarray:
     return Rotation.from_rotvec(q.as_rotvec() * scale).as_matrix().reshape(quaternions.shape[:-1] + (3, 3))
 
 
+def _euler_as_degrees(quaternions: np.ndarray) -> np.ndarray:
+    """The rotations pyBullet's Euler angles of ``quaternions`` (R = Rz(yaw)·Ry(pitch)·Rx(roll): scipy's 'xyz')
+    give when they are read as degrees. The angles are pyBullet's own (``getEulerFromQuaternion``): at a pitch
+    of ±90° it splits the turn between roll and yaw otherwise than scipy's ``as_euler`` (the kit's perturbed
+    runs turn bodies there), and the shrunk turns differ."""
+    shrunk = Rotation.from_euler("xyz", pybullet_euler(quaternions.reshape(-1, 4)), degrees=True)
+    return shrunk.as_matrix().reshape(quaternions.shape[:-1] + (3, 3))
+
+
+def pybullet_euler(quaternions: np.ndarray) -> np.ndarray:
+    """``(n, 3)``: what pyBullet's ``getEulerFromQuaternion`` gives for each of ``quaternions`` ``(n, 4)``, its
+    formula in numpy (pybullet.c; equal to it to 1e-15 rad over 20,000 random turns and 200 at and near a pitch of
+    ±90°, where it puts the whole turn in the yaw)."""
+    x, y, z, w = quaternions.T
+    sarg = -2 * (x * z - w * y)
+    roll = np.arctan2(2 * (y * z + w * x), w * w - x * x - y * y + z * z)
+    pitch = np.arcsin(np.clip(sarg, -1, 1))
+    yaw = np.arctan2(2 * (x * y + w * z), w * w + x * x - y * y - z * z)
+    low, high = sarg <= -0.99999, sarg >= 0.99999
+    roll = np.where(low | high, 0.0, roll)
+    pitch = np.where(low, -0.5 * np.pi, np.where(high, 0.5 * np.pi, pitch))
+    yaw = np.where(low, 2 * np.arctan2(x, -y), np.where(high, 2 * np.arctan2(-x, y), yaw))
+    return np.stack([roll, pitch, yaw], axis=1)
+
+
 def _float32_axis_angle(quaternions: np.ndarray) -> np.ndarray:
     """What pyBullet's ``getAxisAngleFromQuaternion`` gives, as rotations: Bullet's btQuaternion getAngle and
     getAxis in float32 (the angle ``2 acos(w)``, so 0.001 rad comes back as 0.0009765625; the axis (1, 0, 0)
@@ -470,14 +495,16 @@ def _float32_axis_angle(quaternions: np.ndarray) -> np.ndarray:
 #: name → (what it means, function of (positions, quaternions, before_positions, before_quaternions)
 #: giving the frame positions and rotation matrices that mistake draws with)
 VARIANTS = {
-    "previous-step": ("drawn exactly at pyBullet's pose of the previous step: sync after p.stepSimulation(), and "
-                      "read links with getLinkState(..., computeForwardKinematics=1)",
+    "previous-step": ("drawn exactly at pyBullet's pose of the previous step (or of the previous tick, where a tick "
+                      "steps several times): sync after p.stepSimulation(), and read links with getLinkState(..., "
+                      "computeForwardKinematics=1)",
                       lambda p, q, bp, bq: (bp, _rotations(bq))),
     "conjugate": ("drawn with the inverse (conjugate, or transposed-matrix) rotation: a row-vector `v @ R` where "
                   "`R @ v` was meant, or a matrix written transposed",
                   lambda p, q, bp, bq: (p, np.swapaxes(_rotations(q), -1, -2))),
     "wxyz": ("drawn with the quaternion reordered to (w, x, y, z) and handed to something that takes pyBullet's "
-             "(x, y, z, w), as pygfx's local.rotation does: pass pyBullet's quaternion as it is",
+             "(x, y, z, w): scipy's Rotation.from_quat (unless scalar_first=True), pygfx's local.rotation, pyBullet's "
+             "own calls: pass pyBullet's quaternion as it is",
              lambda p, q, bp, bq: (p, _rotations(np.roll(q, 1, axis=-1)))),
     "scalar-first": ("drawn with pyBullet's (x, y, z, w) quaternion read as (w, x, y, z) (scalar first: transforms3d, "
                      "Eigen, scipy's scalar_first=True): read it as (x, y, z, w)",
@@ -487,14 +514,51 @@ VARIANTS = {
                     lambda p, q, bp, bq: (p, _vtk_euler(q))),
     "translation-only": ("moved but never turned: the position is pyBullet's, the rotation the one it was built with",
                          lambda p, q, bp, bq: (p, np.broadcast_to(np.eye(3), p.shape[:-1] + (3, 3)))),
-    "radians-as-degrees": ("turned by the angle in radians where degrees are taken: VTK's RotateWXYZ(angle, x, y, z) "
-                           "and SetOrientation take degrees: give math.degrees(angle)",
+    "radians-as-degrees": ("turned by angles in radians where degrees are taken: VTK's RotateWXYZ(angle, x, y, z), "
+                           "SetOrientation and RotateX/Y/Z, scipy's from_euler(..., degrees=True) and "
+                           "from_rotvec(..., degrees=True) take degrees: give math.degrees(angle), or build the "
+                           "rotation from the quaternion",
                            lambda p, q, bp, bq: (p, _axis_angle(q, np.pi / 180))),
+    # The same mistake made on pyBullet's Euler angles (scipy's from_euler('xyz', getEulerFromQuaternion(q),
+    # degrees=True)): each angle shrunk, not the turn's one angle, which parts from the above past small turns.
+    "radians-as-degrees, Euler": ("", lambda p, q, bp, bq: (p, _euler_as_degrees(q))),
+    # A visual shape's frame composed the wrong way round with its link's (visual @ link): it depends on each
+    # frame's visual frame, which these poses do not hold, so the judgement makes it (judge._variants); here
+    # the link's own pose stands in, which explains nothing.
+    "visual-frame, order": ("", lambda p, q, bp, bq: (p, _rotations(q))),
+    # Drawn a tick late where a tick steps several times (the pose at the end of the previous tick, before the
+    # tick's first step): made by the judgement from the recording's ticks (judge._variants), as above.
+    "previous-step, tick": ("", lambda p, q, bp, bq: (p, _rotations(q))),
     "float32-angle-axis": ("turned by pyBullet's getAxisAngleFromQuaternion, which computes in float32: an angle of "
                            "0.001 rad comes back as 0.0009765625, and below about 0.002 rad the axis is (1, 0, 0): "
                            "build the rotation from the quaternion (getMatrixFromQuaternion, scipy's Rotation.from_quat)",
                            lambda p, q, bp, bq: (p, _float32_axis_angle(q))),
 }
+
+
+#: Variants that are another form of a mistake named before them: the name a diagnosis gives them.
+ALIASES = {"radians-as-degrees, Euler": "radians-as-degrees", "visual-frame, order": "visual-frame",
+           "previous-step, tick": "previous-step"}
+
+
+def visual_order(positions: np.ndarray, rotations: np.ndarray, frames) -> tuple[np.ndarray, np.ndarray]:
+    """Each frame's pose ``(T, F, 3)``, ``(T, F, 3, 3)`` as a drawing shows it whose one visual frame ``(p_v,
+    R_v)`` is composed the wrong way round with the link's ``(p, R)`` (visual @ link where link @ visual is
+    meant): a point at ``x`` in the link frame is drawn at ``R_v R R_vᵀ (x - p_v) + p_v + R_v p``. A frame with
+    no visual frame, or several different ones, keeps its own pose (the mistake cannot be told by frame)."""
+    positions, rotations = np.array(positions, dtype=np.float64), np.array(rotations, dtype=np.float64)
+    for index, frame in enumerate(frames):
+        placed = {(tuple(np.round(v[2], 9)), tuple(np.round(v[3], 9))) for v in getattr(frame, "visuals", ())}
+        if len(placed) != 1:
+            continue
+        p_v, q_v = (np.asarray(a, dtype=np.float64) for a in next(iter(placed)))
+        r_v = Rotation.from_quat(q_v).as_matrix()
+        if np.linalg.norm(p_v) < 1e-9 and np.allclose(r_v, np.eye(3)):
+            continue
+        turned = np.einsum("ij,tjk,lk->til", r_v, rotations[:, index], r_v)
+        positions[:, index] = p_v + positions[:, index] @ r_v.T - turned @ p_v
+        rotations[:, index] = turned
+    return positions, rotations
 
 
 def variant_fit(vertices: np.ndarray, positions: np.ndarray, rotations: np.ndarray, reference: np.ndarray,

@@ -73,6 +73,9 @@ class _Judgement:
         self.followed_badly: set[int] = set()
         self._attached_done = False
         self._placements = None
+        #: per actor index, the vertices `drawn` found to be a moving frame's shape left where it was built
+        self.left_behind: dict[int, set] = {}
+        self._drawn_verdict = None
 
     def _outside(self, frame: int, points: np.ndarray) -> np.ndarray:
         """How far link-frame ``points`` lie outside ``frame``'s collision and visual shapes (0 on or inside one)."""
@@ -112,8 +115,14 @@ class _Judgement:
         catalogue (:data:`~conformance.apps.attachment.VARIANTS`, in its order): computed once for all frames,
         not once for each loose piece and frame (a wrong 100-brick wall's diagnosis spent most of its time there)."""
         before_pos, before_orn = self.r.before_positions[1:], self.r.before_orientations[1:]
-        return [tuple(np.asarray(a) for a in make(self.pos, self.orn, before_pos, before_orn))
+        made = [tuple(np.asarray(a) for a in make(self.pos, self.orn, before_pos, before_orn))
                 for _, make in attach_mod.VARIANTS.values()]
+        # The one mistake whose pose depends on each frame's shapes, not on its pose alone
+        made[list(attach_mod.VARIANTS).index("visual-frame, order")] = attach_mod.visual_order(
+            self.pos, self.rot, self.r.frames)
+        made[list(attach_mod.VARIANTS).index("previous-step, tick")] = (
+            self.r.positions[:-1], _rotations(self.r.orientations[:-1]))
+        return made
 
     @functools.cached_property
     def _variant_stack(self) -> tuple[np.ndarray, np.ndarray]:
@@ -258,6 +267,7 @@ class _Judgement:
                 piece = rows[s:e]
                 if mistakes[s]:
                     frame, diagnosis = int(frames[s]), list(attach_mod.VARIANTS)[mistakes[s] - 1]
+                    diagnosis = attach_mod.ALIASES.get(diagnosis, diagnosis)
                     if diagnosis == "previous-step":  # or later than the step: before the app's own moves
                         diagnosis = self._later_than_the_step(track.vertices[1:, piece], frame, a.reference[piece]) \
                             or diagnosis
@@ -344,7 +354,7 @@ class _Judgement:
                 if name == "previous-step" and not attach_mod.variant_fit(
                         vertices, positions, rotations, reference, allowance, np.arange(len(vertices))):
                     return "skipped"
-                return name
+                return attach_mod.ALIASES.get(name, name)
         return "skipped" if self._skipped(vertices, frame, allowance) else ""
 
     @functools.cached_property
@@ -447,10 +457,13 @@ class _Judgement:
                 continue
             verdict.passed = False
             line = (f"{frame.label} moves ({moved:.3g} m over ticks 1..{self.r.ticks}) but no drawn vertex follows it")
-            near = self._left_behind(index)
+            near, rows = self._left_behind(index)
             verdict.lines.append(line + (f"; {near} stays where it was built" if near else ""))
             if near:
                 verdict.diagnosed("never-moved")
+                if rows is not None:
+                    self.left_behind.setdefault(rows[0], set()).update(range(rows[1], rows[2]))
+        self._drawn_verdict = verdict
         return verdict
 
     def _drawn_on_its_weld(self, index: int, followed: set) -> bool:
@@ -494,12 +507,16 @@ class _Judgement:
         turn = (Rotation.from_quat(self.r.orientations[:, index]) * Rotation.from_quat(self.r.orientations[0, index]).inv()).magnitude()
         return float(max(np.max(np.linalg.norm(p - p[0], axis=1)), np.max(turn) * radius))
 
-    def _left_behind(self, index: int) -> str:
+    def _left_behind(self, index: int) -> tuple[str, tuple | None]:
         """An actor range held by the world that sits on this frame as it was at the start: of several near
         it, one that is the frame's shape there (its extents in the frame's axes), else the nearest (a nail
-        drawn beside the rope's last bead is not that bead)."""
+        drawn beside the rope's last bead is not that bead). Its label, and ``(actor index, start, stop)``
+        when it is the frame's shape (else None): those vertices are this frame's drawing, not the world's."""
         found = self._left_behind_all(index)
-        return min((not ok, distance, label) for ok, distance, label in found)[2] if found else ""
+        if not found:
+            return "", None
+        ok, _, label, rows = min(found, key=lambda f: (not f[0], f[1]))
+        return label, rows if ok else None
 
     def _left_behind_all(self, index: int) -> list[tuple[bool, float, str]]:
         """``(is the frame's shape, distance, label)`` of each actor range the world (or a body that never
@@ -510,25 +527,35 @@ class _Judgement:
         still = [i for i, f in enumerate(self.r.frames) if self._movement(i, bounding_radius(f.shapes) if f.shapes else 0.0) == 0.0]
         origin, turn = self.r.positions[0, index], _rotations(self.r.orientations[0, index])
         found = []
-        for track, a in zip(self.r.actors, self.attachments):
+        for k, (track, a) in enumerate(zip(self.r.actors, self.attachments)):
             world = np.flatnonzero(((a.frame < 0) | np.isin(a.frame, still)) & a.held)
             if not len(world):
                 continue
-            for start, stop in _runs(np.isin(np.arange(len(a.frame)), world), a.frame):
+            # Runs of one holder, and runs across holders: whatever never moves holds them alike, so a link left
+            # where it was built whose vertices the world and the ground plate hold in turns (a cylinder's top cap
+            # and its bottom one) is one run; a ground drawn next to it in one shared actor is not part of it.
+            mask = np.isin(np.arange(len(a.frame)), world)
+            runs = dict.fromkeys([*_runs(mask, a.frame), *_runs(mask, np.zeros(len(a.frame), dtype=int))])
+            for start, stop in runs:
                 points = track.vertices[0, start:stop]
                 distance = float(np.linalg.norm(points.mean(axis=0) - origin))
-                if distance > radius + 0.01:
-                    # Built in the link frame and never posed: the world holds the frame's shape at its origin.
-                    unposed = place(points, info.shapes, self._inertial(index), tolerance=self.tolerance,
-                                    mesh=info.mesh, visuals=info.visuals)
-                    if unposed.judged and unposed.ok:
-                        found.append((True, distance, f"{track.label} vertices {start}:{stop} (at the world's origin, "
-                                      "never posed)"))
-                    continue
-                local = (points - origin) @ turn  # in the frame as it was at the start
-                placed = place(local, info.shapes, self._inertial(index), tolerance=self.tolerance, mesh=info.mesh,
-                               visuals=info.visuals)
-                found.append((placed.judged and placed.ok, distance, f"{track.label} vertices {start}:{stop}"))
+                if distance <= radius + 0.01:
+                    local = (points - origin) @ turn  # in the frame as it was at the start
+                    placed = place(local, info.shapes, self._inertial(index), tolerance=self.tolerance, mesh=info.mesh,
+                                   visuals=info.visuals)
+                    if placed.judged and placed.ok:
+                        found.append((True, distance, f"{track.label} vertices {start}:{stop}", (k, start, stop)))
+                        continue
+                # Built in the link frame and never posed: the world holds the frame's shape at its origin (a body
+                # that starts near the origin, a brick dropped from 3 cm, is near both); an actor per visual shape,
+                # built in the shape's own frame and posed by link @ visual, holds it there without its visual frame.
+                unposed = place(points, info.shapes, self._inertial(index), tolerance=self.tolerance,
+                                mesh=info.mesh, visuals=info.visuals)
+                if unposed.judged and (unposed.ok or unposed.diagnosis == "visual-frame"):
+                    found.append((True, distance, f"{track.label} vertices {start}:{stop} (at the world's origin, "
+                                  "never posed)", (k, start, stop)))
+                elif distance <= radius + 0.01:
+                    found.append((False, distance, f"{track.label} vertices {start}:{stop}", (k, start, stop)))
         return found
 
     def placements(self) -> list:
@@ -561,8 +588,17 @@ class _Judgement:
         # A frame some drawing shows at its size may carry others (a halo, a marker): those are decorations.
         # One drawn only at another size, every part scaled by one factor, is drawn at the wrong size.
         at_its_size = {frame for _, _, frame, _, result in self.placements() if result.judged}
+        if self._drawn_verdict is None:
+            self.drawn()  # which still vertices are a moving link left where it was built (self.left_behind)
         for track, a, frame, rows, result in self.placements():
             info = self.r.frames[frame]
+            left = self.left_behind.get(next(k for k, t in enumerate(self.r.actors) if t is track), set())
+            if left and left.intersection(rows.tolist()):
+                rows = np.array([r for r in rows if r not in left], dtype=int)
+                if not len(rows):
+                    continue  # `drawn` names them: the link left where it was built, not a drawing of this frame
+                result = place(_drawn_points(a.reference[rows], track.radii, rows), info.shapes, self._inertial(frame),
+                               tolerance=self.tolerance, mesh=info.mesh, visuals=info.visuals)
             if info.node >= 0:
                 soft.setdefault((track.label, info.client, info.body, info.name), []).append(
                     (rows, frame, soft_bodies.off_node(self, a.reference[rows], frame)))
@@ -638,7 +674,9 @@ class _Judgement:
                 what = (f"at tick {silent[0]} {words}" if words else
                         f"its vertex data changed at tick {silent[0]} without being announced to the renderer")
                 verdict.lines.append(f"{track.label} ({track.kind}): {what} ({len(silent)} ticks in all)")
-                verdict.diagnosed("unannounced")
+                # Announced, but not where it changed (FURY 2's ranges, conformance.backends.pygfx.unannounced's
+                # words): the GPU keeps the rest, which is what stale-gpu says; nothing announced is unannounced
+                verdict.diagnosed("stale-gpu" if words and "outside every range announced" in words else "unannounced")
         return verdict
 
 

@@ -206,7 +206,7 @@ def _mistakes(visuals) -> list[tuple[str, np.ndarray, np.ndarray]]:
     """What a drawing of a frame's visual shapes spans when their usual mistakes are made, ``(diagnosis,
     centre, half)``, for each shape and for all of them together: drawn without its visual frame
     (``getVisualShapeData(...)[5:7]`` left out), a mesh drawn without its scale."""
-    unframed, unscaled = [], []
+    unframed, unscaled, factors = [], [], set()
     for kind, dims, position, orientation, points in visuals:
         own = np.asarray(points, dtype=np.float64)
         framed = np.linalg.norm(position) > 1e-9 or abs(abs(orientation[3]) - 1) > 1e-9
@@ -214,14 +214,21 @@ def _mistakes(visuals) -> list[tuple[str, np.ndarray, np.ndarray]]:
         scale = np.asarray(dims[:3], dtype=np.float64)
         scaled = kind == "mesh" and np.all(scale > 0) and np.any(np.abs(scale - 1) > 1e-6)
         unscaled.append(_framed((kind, dims, position, orientation, own / scale)) if scaled else None)
+        if scaled:
+            factors.add(float(scale[0]) if np.all(np.abs(scale - scale[0]) <= 1e-6 * scale[0]) else 0.0)
+    # A mesh scale the same on every axis left out draws the shape at one factor, which is also what leaving
+    # out loadURDF's globalScaling draws (pyBullet keeps it in the mesh scale): the drawing cannot tell the two
+    # apart, so it is named by what it shows, "scaled", with the factor. One that differs by axis is the mesh's.
+    uniform = len(factors) == 1 and 0.0 not in factors
     found = []
-    for diagnosis, wrong, right in (("visual-frame", unframed, [None] * len(visuals)), ("mesh-scale", unscaled, [None] * len(visuals))):
+    for diagnosis, wrong in (("visual-frame", unframed), ("scaled" if uniform else "mesh-scale", unscaled)):
         if not any(w is not None for w in wrong):
             continue
-        found += [(diagnosis, *_box(w)) for w in wrong if w is not None]
+        factor = next(iter(factors)) if diagnosis == "scaled" else 0.0
+        found += [(diagnosis, *_box(w), factor) for w in wrong if w is not None]
         if len(visuals) > 1:  # the link drawn from all its visuals, each with the mistake where it applies
             together = [w if w is not None else _framed(v) for w, v in zip(wrong, visuals)]
-            found.append((diagnosis, *_box(np.concatenate(together))))
+            found.append((diagnosis, *_box(np.concatenate(together)), factor))
     return found
 
 
@@ -264,14 +271,18 @@ def place(reference: np.ndarray, shapes, inertial_position, *, tolerance: Tolera
         told = []  # (diagnosis, shape) for each shape of the drawing's size, nearest first
         for _, what, which, centre, room, offset, slack in sorted(sized, key=lambda entry: entry[0]):
             diagnosis = ""
-            if np.linalg.norm(inertial) > room:
-                if np.all(np.abs(offset - inertial) <= room):
-                    diagnosis = "com-frame"
-                elif np.all(np.abs(offset - 2 * inertial) <= room) or np.all(np.abs(offset + inertial) <= room):
-                    diagnosis = "offset-sign"
-            for mistake, m_centre, m_half in _mistakes(visuals):
+            off_com = np.linalg.norm(inertial) > room
+            if off_com and np.all(np.abs(offset - inertial) <= room):
+                diagnosis = "com-frame"
+            for mistake, m_centre, m_half, _ in _mistakes(visuals):
                 if not diagnosis and np.all(np.abs(m_half - drawn_half) <= room) and np.all(np.abs(m_centre - drawn_centre) <= room):
                     diagnosis = mistake
+            # After the visual shape's mistakes: a URDF whose <inertial> and <visual> share their <origin> (a
+            # pendulum's bob) drawn without its visual frame is off by minus the inertial offset too, and a program
+            # that draws visual shapes leaves out their frame far oftener than it turns the offset round.
+            if not diagnosis and off_com and (np.all(np.abs(offset - 2 * inertial) <= room)
+                                              or np.all(np.abs(offset + inertial) <= room)):
+                diagnosis = "offset-sign"
             told.append((diagnosis, what, which, centre, offset, slack))
         # the shape a known mistake explains, else the nearest
         diagnosis, what, which, centre, offset, slack = next((t for t in told if t[0]), told[0])
@@ -279,10 +290,12 @@ def place(reference: np.ndarray, shapes, inertial_position, *, tolerance: Tolera
         return Placement(True, False, f"drawn {np.linalg.norm(offset):.4g} m off {what} (drawn centre "
                          f"{_v(drawn_centre)} in the link frame, the shape's {_v(centre)}; allowed {slack[axis]:.3g} m "
                          f"along {'xyz'[axis]})", offset, diagnosis, which)
-    for mistake, m_centre, m_half in _mistakes(visuals):
+    for mistake, m_centre, m_half, factor in _mistakes(visuals):
         room = allowance(m_half)
         if np.all(np.abs(m_half - drawn_half) <= room) and np.all(np.abs(m_centre - drawn_centre) <= room):
-            return Placement(True, False, f"drawn as its visual shape {_MISTAKEN[mistake]} (half extents {_v(drawn_half)}, "
+            how = (_MISTAKEN[mistake] if not factor else f"at {1 / factor:.4g} times its size: its mesh scale {factor:.4g} "
+                   "(getVisualShapeData(...)[3], which holds loadURDF's globalScaling) left out")
+            return Placement(True, False, f"drawn as its visual shape {how} (half extents {_v(drawn_half)}, "
                              f"centre {_v(drawn_centre)} in the link frame)", drawn_centre, mistake, "visual")
     for what, which, centre, half in shapes_of:
         if np.all(np.abs(np.sort(drawn_half) - np.sort(half)) <= allowance(half)):

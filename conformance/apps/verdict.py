@@ -9,10 +9,10 @@ from dataclasses import dataclass, field
 
 from conformance.apps import attachment as attach_mod
 
-__all__ = ["DIAGNOSES", "Verdict"]
+__all__ = ["DIAGNOSES", "LEAD_ORDER", "Verdict", "lead", "lead_line"]
 
 #: diagnosis id → what it means, for the docs and every failure line
-DIAGNOSES = {name: text for name, (text, _) in attach_mod.VARIANTS.items()} | {
+DIAGNOSES = {name: text for name, (text, _) in attach_mod.VARIANTS.items() if name not in attach_mod.ALIASES} | {
     "com-frame": "drawn at the centre-of-mass frame (getBasePositionAndOrientation, or getLinkState()[0:2]) instead "
                  "of the link frame: undo getDynamicsInfo(body, link)[3:5], or read getLinkState()[4:6]",
     "never-moved": "left where it was built while its body moves: the sync never sets this actor (or this range)",
@@ -21,12 +21,15 @@ DIAGNOSES = {name: text for name, (text, _) in attach_mod.VARIANTS.items()} | {
     "offset-sign": "drawn with the centre-of-mass offset applied the wrong way (twice its offset from the link frame, or "
                    "undone twice): the link frame is the centre of mass moved by minus getDynamicsInfo(body, link)[3:5], "
                    "turned by the centre of mass's orientation",
-    "visual-frame": "drawn without its visual frame: a URDF places each visual shape in its link frame "
-                    "(getVisualShapeData(body)[i][5:7], the <visual><origin>), which the actor must be moved by",
+    "visual-frame": "drawn without its visual frame, or with it composed the wrong way round (visual @ link where "
+                    "link @ visual is meant): a URDF places each visual shape in its link frame "
+                    "(getVisualShapeData(body)[i][5:7], the <visual><origin>), which the actor must be moved by, "
+                    "after the link's pose",
     "mesh-scale": "drawn without its mesh scale: getVisualShapeData(body)[i][3] (the URDF's <mesh scale>) scales the "
                   "mesh file's vertices",
     "scaled": "drawn at another size than its shape, every part of it by one factor (the line states it), and "
-              "nowhere at its size: a scale applied twice or left out. loadURDF's globalScaling is already in "
+              "nowhere at its size: a scale applied twice or left out, or a size given in other terms (a diameter "
+              "where a radius is taken). loadURDF's globalScaling is already in "
               "getVisualShapeData's dimensions, mesh scales and frames, and in every pose: scale nothing again; a "
               "mesh file's vertices take getVisualShapeData(body)[i][3]",
     "before-own-move": "drawn at the pose pyBullet held after the tick's step but before the app's own moves of that "
@@ -61,6 +64,33 @@ DIAGNOSES = {name: text for name, (text, _) in attach_mod.VARIANTS.items()} | {
                  "with positions.update_range(offset, count) does not cover them (offset and count are in vertices); "
                  "announce every range written, or update_full()",
 }
+
+
+#: The diagnoses from the most explanatory to the least, which decides the one a failing run leads with
+#: (:func:`lead`). A mistake of the pose or of the tick's order reproduces every drawn vertex of a frame, so it
+#: comes first; then what a check sees directly (a write back, a change never announced, a body hidden); then a
+#: shape's size and frame; then the generic ones, which say where a drawing is and not why: a link scaled 1.6
+#: times is also "not its shape" in the picture and "follows another body" where its vertices left their link.
+#: Measured on the zoo's injected mistakes (``python -m conformance confusion``, docs/confusion.md).
+LEAD_ORDER = ("before-own-move", "skipped", "previous-step", "wxyz", "scalar-first", "euler-order", "radians-as-degrees",
+              "float32-angle-axis", "conjugate", "translation-only", "written-back", "unannounced", "stale-gpu",
+              "node-order", "face-order", "stale-normals", "hidden", "scaled", "mesh-scale", "com-frame", "visual-frame",
+              "offset-sign", "turned-shape", "never-moved", "other-body", "not-its-shape")
+
+
+def lead(diagnoses) -> str:
+    """The diagnosis a failing run leads with, of those its checks named (``diagnoses``, any order): the
+    first of :data:`LEAD_ORDER`; "" when none was named. A function of the set alone, so a verdict kept
+    as a set of names (the zoo's journal) is led the same way."""
+    named = set(diagnoses)
+    return next((name for name in LEAD_ORDER if name in named), "")
+
+
+def lead_line(verdicts) -> str:
+    """The line a failing run's report opens with when a check named a mistake: which one and where, or ""."""
+    named = {d: check for check, v in reversed(list(verdicts.items())) if not v.passed for d in v.diagnoses}
+    first = lead(named)
+    return f"the mistake, most likely ({named[first]} names it): {DIAGNOSES[first]}" if first else ""
 
 
 @dataclass

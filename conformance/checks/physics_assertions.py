@@ -100,14 +100,15 @@ def assert_collision(*, actual: Outcome, expected: bool, where: str) -> None:
                     f"free flight kept) {where}", pytrace=False)
 
 
-def assert_drawn_overlapping(*, inside: Mapping[str, bool], distance: float, where: str) -> None:
-    """Each body's drawn centre lies inside the other's drawn shape."""
+def assert_drawn_overlapping(*, inside: Mapping[str, bool], distance: float, where: str, explained: str = "") -> None:
+    """Each body's drawn centre lies inside the other's drawn shape. ``explained``: the ``diagnosis: …`` line of
+    the frame's vertices, when a known mistake draws them where they are (printed under the failure)."""
     __tracebackhide__ = True
     missing = [name for name, ok in inside.items() if not ok]
     if missing:
         pytest.fail(f"drawn centre of {', '.join(missing)} outside the other body's drawn shape (drawn centres "
                     f"{distance:.4g} m apart), but physics has the pair interpenetrating, so they should be drawn "
-                    f"overlapping {where}", pytrace=False)
+                    f"overlapping {where}" + (f"\n{explained}" if explained else ""), pytrace=False)
 
 
 def assert_interpenetrating(*, contacts: tuple[int, ...], distance: float, depth: float, where: str) -> None:

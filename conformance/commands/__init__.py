@@ -5,4 +5,4 @@ Each module defines ``NAME``, ``HELP``, ``add_arguments(parser)`` and ``run(args
 """
 
 #: The commands in the order ``--help`` lists them.
-MODULES = ["run", "app", "app_table", "scenes", "render", "check", "compare", "verdicts", "kill_rate", "mutants", "tolerance_use", "precision", "zoo", "regen", "bench", "documented"]
+MODULES = ["run", "app", "app_table", "scenes", "render", "check", "compare", "verdicts", "kill_rate", "mutants", "tolerance_use", "precision", "zoo", "confusion", "regen", "bench", "documented"]

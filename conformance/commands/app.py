@@ -40,6 +40,10 @@ def _print_result(result, label: str, results=None, notes: int | None = NOTES) -
     r = result.recording
     steps = sorted(set(int(s) for s in r.steps[1:])) or [0]
     print(f"{label}: {r.ticks} ticks ({'/'.join(map(str, steps))} step(s) per tick); {r.ended}")
+    from conformance.apps.verdict import lead_line
+
+    if lead_line(result.verdicts):  # the first line read names the mistake, whichever check found it
+        print(f"  {lead_line(result.verdicts)}")
     for check, verdict in result.verdicts.items():
         figure = f"  worst {verdict.worst:.3g} of its allowance" if verdict.worst is not None and verdict.passed else ""
         print(f"  {'PASS' if verdict.passed else 'FAIL'} {check}{figure}")

@@ -27,7 +27,7 @@ from conformance.bullet import poses, truth
 
 __all__ = ["EULER_ORDERS", "MISTAKES", "NORMAL_MISTAKES", "SOFT_WORDS", "Drawn", "diagnose", "diagnose_frame",
            "diagnose_normals", "diagnose_problems", "drawn_now", "explain", "explain_failures", "explain_frame",
-           "explain_normals", "soft_drawn_as_rigid", "soft_names", "unannounced"]
+           "explain_normals", "late_or_once", "name_of", "soft_drawn_as_rigid", "soft_names", "unannounced"]
 
 #: name → what it means (printed after "diagnosis: ")
 MISTAKES = {
@@ -47,7 +47,8 @@ MISTAKES = {
     "euler-order": "drawn with pyBullet's Euler angles composed in another order than pyBullet's ({order}; "
                    "getEulerFromQuaternion's angles mean R = Rz(yaw)·Ry(pitch)·Rx(roll), turns about fixed x, y, z): "
                    "set the rotation from the quaternion",
-    "never-moved": "drawn where it was built: this target's vertices (or its actor's transform) were never updated",
+    "never-moved": "drawn where it was built: this target's vertices (or its actor's transform) were never updated "
+                   "(a loop that skips it, a condition that leaves it out, or vertex ranges that miss it)",
     "translation-only": "moved but never turned: the position is pyBullet's, the rotation the one it was built with",
     "rotation-only": "turned but never moved: the rotation is pyBullet's, the position the one it was built with",
     "other-target": "drawn at the pose of {other}: the vertex range or the actor was paired with the wrong body or link",
@@ -63,6 +64,11 @@ SOFT_WORDS = {
     "never-moved": "drawn at the soft body's nodes as built: its vertices were never copied again; " + _COPY,
     "late-or-once": "drawn at the soft body's nodes of the previous step (frame {frame}), which are the nodes as "
                     "built: copied one step late or only once, which the next frames tell apart; " + _COPY,
+    "part-copied": "only {copied} of the soft body's {count} vertices follow its nodes; the others are drawn where "
+                   "they were built or a step late: the copy stops short (a slice, a loop bound, another mesh's count); "
+                   + _COPY,
+    "float16": "drawn at the soft body's nodes rounded to float16 (half precision: 11 bits, a millimetre at two "
+               "metres): keep the vertices in float32 or float64; " + _COPY,
     # A sync written before soft bodies, which hands every target to its pose code: kept under the
     # JUnit message's share of a diagnosis (conformance.reports.junit), so that -m "not soft" stays in it.
     "drawn-as-rigid": "{name} is a soft body (Target.nodes is not None) and the sync {how}: its vertices must follow "
@@ -265,7 +271,8 @@ def _explain_soft(run, drawn: Drawn, tolerance: float) -> tuple[str, str] | None
     candidates = []
     if drawn.physics.previous_nodes is not None and i in drawn.physics.previous_nodes:
         candidates.append(("previous-step", {"frame": drawn.frame - 1}, drawn.physics.previous_nodes[i][t.nodes]))
-    candidates.append(("never-moved", {}, run.drawing.local[i]))
+    if drawn.frame > 0:  # at frame 0 the nodes as built are what the sync's one call was given to copy
+        candidates.append(("never-moved", {}, run.drawing.local[i]))
     held = []
     for name, words, expected in candidates:
         if np.max(np.linalg.norm(expected - truth_vertices, axis=1)) <= DISTINCT * allowance:
@@ -277,6 +284,9 @@ def _explain_soft(run, drawn: Drawn, tolerance: float) -> tuple[str, str] | None
         # At frame 1 the previous step's nodes are the built ones: the name stays the first that holds
         words_of = "late-or-once" if [n for n, _ in held] == ["previous-step", "never-moved"] else name
         return name, "diagnosis: " + SOFT_WORDS[words_of].format(**words)
+    found = _soft_partly(drawn, truth_vertices, candidates, allowance)
+    if found:
+        return found
     for position, matrix in (drawn.physics.rigid_poses or {}).get(i, ()):  # its vertices rewritten at a rigid pose
         expected = built @ matrix.T + position
         if np.max(np.linalg.norm(expected - truth_vertices, axis=1)) <= DISTINCT * allowance:
@@ -289,6 +299,30 @@ def _explain_soft(run, drawn: Drawn, tolerance: float) -> tuple[str, str] | None
     if np.all(distance <= allowance) and np.any(nearest != t.nodes):
         return "node-order", "diagnosis: " + MISTAKES["node-order"]
     return None
+
+
+def _soft_partly(drawn: Drawn, truth_vertices, candidates, allowance: float) -> tuple[str, str] | None:
+    """A soft body's drawing that is its nodes in part, or in a precision too low: some vertices at their nodes
+    now and every other one at its node a step late or as built (``part-copied``), or every vertex at its node
+    rounded to float16 (``float16``)."""
+    off = np.linalg.norm(drawn.vertices - truth_vertices, axis=1)
+    right = off <= allowance
+    if right.any() and not right.all():
+        stale = np.zeros(len(right), dtype=bool)
+        for _, _, expected in candidates:
+            stale |= np.linalg.norm(drawn.vertices - expected, axis=1) <= allowance
+        if np.all(right | stale) and np.any(off[~right] > DISTINCT * allowance):
+            return "part-copied", "diagnosis: " + SOFT_WORDS["part-copied"].format(copied=int(right.sum()), count=len(right))
+    half = truth_vertices.astype(np.float16).astype(np.float64)
+    if np.max(np.linalg.norm(half - truth_vertices, axis=1)) > DISTINCT * allowance and \
+            np.max(np.linalg.norm(drawn.vertices - half, axis=1)) <= allowance:
+        return "float16", "diagnosis: " + SOFT_WORDS["float16"]
+    return None
+
+
+def late_or_once(frame: int) -> str:
+    """The ``diagnosis: …`` line of a soft body copied one step late or only once, not told apart at ``frame``."""
+    return "diagnosis: " + SOFT_WORDS["late-or-once"].format(frame=frame - 1)
 
 
 def _as_rigid(t, how: str) -> str:
@@ -433,3 +467,31 @@ def diagnose_problems(run) -> str:
     if any(frame == run.frame for frame, *_ in run.unannounced):
         return unannounced()
     return ""
+
+
+def name_of(line: str) -> str:
+    """The catalogue's name of the mistake a ``diagnosis: …`` line (or what follows its label) states, or ""
+    for a line it did not write: how a record kept as text (the plugin's ``diagnosis``) is counted by name
+    (``python -m conformance confusion``)."""
+    text = line.strip()
+    text = text[len("diagnosis: "):] if text.startswith("diagnosis: ") else text
+    for name, pattern in _patterns():
+        if pattern.match(text):
+            return name
+    return ""
+
+
+def _patterns():
+    import re
+
+    if not _PATTERNS:
+        words = {**{f"soft {k}": v for k, v in SOFT_WORDS.items()}, **NORMAL_MISTAKES, **MISTAKES}
+        for key, template in sorted(words.items(), key=lambda kv: -len(kv[1])):  # the longest (most specific) first
+            parts = re.split(r"\{[a-z_]*\}", template)
+            name = key.removeprefix("soft ")
+            # what follows the words (a note on how the mistake was told) is not part of them
+            _PATTERNS.append((name, re.compile(".*?".join(map(re.escape, parts)), re.S)))
+    return _PATTERNS
+
+
+_PATTERNS: list = []

@@ -83,6 +83,12 @@ class Run:
                 self._before_events.append((event, before))
                 event.apply(self.scene)
 
+    def apply_event(self, event: Event) -> None:
+        """Apply one event now (not scheduled: the sync-order machine's), noting what pyBullet read just before
+        it, as scheduled events are: a drawing left at that pose is named (``before-event``)."""
+        self._before_events.append((event, truth.read_states(self.drawing.world.p, self._items)))
+        event.apply(self.scene)
+
     def step(self) -> None:
         """One frame of physics without syncing: events, actions, ``stepSimulation``."""
         self.frame += 1

@@ -14,6 +14,7 @@ import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
+from conformance.apps.verdict import lead
 from conformance.zoo.mistakes import LIMITS
 from conformance.zoo.models import Model
 from conformance.zoo.programs import program
@@ -84,7 +85,8 @@ def judge_program(path: Path, model: Model, style: Style, backend: str, *, ticks
             outcome.failed = list(failing)
             first = next(iter(failing.values()))
             outcome.first = f"{next(iter(failing))}: {first.lines[0] if first.lines else ''}"[:400]
-            outcome.diagnoses = sorted({d for v in failing.values() for d in v.diagnoses})
+            named = list(dict.fromkeys(d for v in failing.values() for d in v.diagnoses))  # as the report reads
+            outcome.diagnoses = sorted(named, key=lambda d: d != lead(named))
             outcome.reproduce = result.reproduce()
     outcome.seconds = round(time.perf_counter() - start, 2)
     return outcome

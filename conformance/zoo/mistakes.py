@@ -113,7 +113,8 @@ MISTAKES = {m.name: m for m in (
             "left out)", "visual-frame", _visual_frame),
     Mistake("visual-order", "each visual shape's frame composed the wrong way round with its link frame",
             "visual-frame", _visual_order),
-    Mistake("mesh-scale", "mesh files drawn without their scale (getVisualShapeData()[3] left out)", "mesh-scale",
+    # A mesh scale the same on every axis left out is a drawing at one factor, named "scaled" (placement._mistakes)
+    Mistake("mesh-scale", "mesh files drawn without their scale (getVisualShapeData()[3] left out)", "scaled|mesh-scale",
             lambda drawing, backend: [(_SCALE, "")]),
     Mistake("scaling-twice", "globalScaling applied again to shapes pyBullet already scaled", "scaled",
             lambda drawing, backend: [("    return mesh\n\n\ndef in_link_frame", "    mesh.apply_scale(GLOBAL_SCALING)\n"

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from collections import Counter
 
+from conformance.apps.verdict import lead
 from conformance.zoo.styles import STYLES, applicable
 
 __all__ = ["markdown"]
@@ -125,9 +126,10 @@ def _named(wrong) -> list[str]:
     from conformance.zoo.mistakes import MISTAKES
 
     lines = ["## Mistakes named", "",
-             "What the first failing check's diagnoses say of each rejected program, both FURYs together (each "
-             "program's latest verdict): the mistake's own diagnosis first, later, none at all, or another first "
-             "(named wrong).", "",
+             "Which mistake each rejected program's report leads with (its first line after the run's, the most "
+             "explanatory of the diagnoses its checks named: `conformance.apps.verdict.LEAD_ORDER`), both FURYs "
+             "together (each program's latest verdict): the mistake's own diagnosis first, later, none at all, or "
+             "another first (named wrong).", "",
              "| mistake | its diagnosis | rejected | named first | named later | none | another first (which) |",
              "|---|---|---|---|---|---|---|"]
     totals = Counter()
@@ -137,15 +139,16 @@ def _named(wrong) -> list[str]:
             continue
         count, others = Counter(), Counter()
         for o in mine:
-            first = o.diagnoses[0] if o.diagnoses else ""
-            cell = ("first" if first == mistake.diagnosis else "later" if mistake.diagnosis in o.diagnoses
+            first = lead(o.diagnoses)
+            names = mistake.diagnosis.split("|")  # "a|b": the drawing calls for one of the two
+            cell = ("first" if first in names else "later" if set(names) & set(o.diagnoses)
                     else "none" if not first else "other")
             count[cell] += 1
             if cell == "other":
                 others[first] += 1
         totals.update(count)
         which = ", ".join(f"{k} {v}" for k, v in others.most_common(3))
-        lines.append(f"| {name} | `{mistake.diagnosis or '-'}` | {len(mine)} | {count['first']} | {count['later']} | "
+        lines.append(f"| {name} | `{(mistake.diagnosis or '-').replace('|', '` or `')}` | {len(mine)} | {count['first']} | {count['later']} | "
                      f"{count['none']} | {count['other']}{f' ({which})' if which else ''} |")
     judged = sum(totals.values()) or 1
     lines += ["", f"Named first: {totals['first']} of {sum(totals.values())} ({100 * totals['first'] / judged:.0f} %); "

@@ -12,7 +12,7 @@ Physics: a static floor and four walls (boxes), balls of radius 0.12-0.2 m and 0
 walls are drawn by one box actor that never moves.
 
 MISTAKE: gives actor.sphere the balls' diameters (2 r) as its radii, so every ball is drawn twice the size of the sphere pyBullet simulates
-EXPECT: fail pictured not-its-shape
+EXPECT: fail placed scaled
 """
 
 import itertools

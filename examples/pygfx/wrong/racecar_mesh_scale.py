@@ -13,7 +13,7 @@ Velocity motors turn the wheels and the differentials' side gears, the steering 
 fro; on ``plane.urdf``, gravity -10, 1/240 s, 150 steps.
 
 MISTAKE: reads each mesh file and leaves out getVisualShapeData's scale (the URDF's <mesh scale="0.001 0.001 0.001">), so the differentials' gears, modelled in millimetres, are drawn a thousand times too large
-EXPECT: fail placed mesh-scale
+EXPECT: fail placed scaled
 """
 
 import itertools
