@@ -517,7 +517,7 @@ class Float32Steps:
         actors = {}
         for t in self.targets:
             if t.nodes is not None:  # a soft body's vertices are its nodes, copied (in float32 too): no pose to step
-                self.vertices[id(t.actor)][t.start:t.stop] = soft_nodes(self.p, t.body)[t.nodes]
+                self.vertices[id(t.actor)][t.start:t.stop] = np.asarray(soft_nodes(self.p, t.body))[t.nodes]
                 actors[id(t.actor)] = t.actor
                 continue
             pos, orn = self.link_pose(t)
