@@ -216,3 +216,22 @@ def test_an_app_s_reproduce_line_keeps_its_tick_function():
     assert words[:4] == ["python", "-m", "conformance", "app"] and words[4] == "my app.py"
     assert words[words.index("--tick") + 1] == "on_frame" and words[words.index("--ticks") + 1] == "30"
     assert "--tick" not in shlex.split(reproduce_command("app.py", 30))
+
+
+@pytest.mark.parametrize("drawn, diagnosis", [("at the end", ""), ("before its own move", "before-own-move"),
+                                              ("before the step", "previous-step")])
+def test_a_playback_drawn_a_tick_behind_is_told_its_mistake_by_a_run_of_the_kits_moves(tmp_path, drawn, diagnosis):
+    """Issue 48: a playback drawn before its own reset and one drawn before the step draw the same vertices on
+    their own run (the judge names the tie); the kit's short run with its moves after the step tells them apart,
+    and the report names the one made and says how it was told. A right playback passes and gets no such run."""
+    from conformance.apps.verdict import lead
+
+    result = apps.check_app(_copy(tmp_path, app_sources.played_back(drawn)), ticks=12)
+    named = {d for v in result.verdicts.values() for d in v.diagnoses}
+    assert result.passed == (not diagnosis), {c: v.message() for c, v in result.verdicts.items()}
+    if diagnosis:
+        alone = {d for v in apps.judge(result.recording).values() for d in v.diagnoses}
+        assert "late-or-own-move" in alone, alone  # the own run alone cannot tell
+        assert lead(named) == diagnosis and "late-or-own-move" not in named, named
+        notes = [n for v in result.verdicts.values() for n in v.notes if "told apart" in n]
+        assert notes and notes[0].startswith(f"{diagnosis}, not "), notes

@@ -93,6 +93,32 @@ def test_a_visual_frame_composed_the_wrong_way_round_is_named():
     assert judge(rec.recording([_leg_frame()], [poses], [rec.track(right, label="leg_actor")]), checks=("attached",))["attached"].passed
 
 
+def test_a_visual_frame_whose_offset_is_turned_by_its_own_rotation_is_named():
+    """``R_v (x + p_v)`` where ``R_v x + p_v`` is meant (the visual frame's turn applied after its offset, the
+    zoo's ``links`` and ``shared`` drawings of visual-order): rigid in the link frame, so ``placed`` names it
+    (it named another body: the leg is 0.42 m off)."""
+    turn = Rotation.from_quat(LEG_FRAME[1])
+    placed = _drawn(_leg_frame(), turn.apply(_primitive_points("box", LEG) + LEG_FRAME[0]))
+    assert not placed.passed and placed.diagnoses == ["visual-frame"], placed.lines
+
+
+def test_a_shape_of_a_link_with_several_visual_frames_composed_the_wrong_way_round_is_named():
+    """One actor per visual shape posed by ``visual_frame @ link_frame``, on a link with two visual shapes in
+    different frames (a robot's link often has several): the catalogue's variant composes one frame only, so
+    each shape is tried under its frame (the zoo's ``shapes`` and ``merged`` drawings were named nothing)."""
+    poses = rec.motion()
+    other = ((0.1, 0.2, 0.0), tuple(Rotation.from_euler("x", 30, degrees=True).as_quat()))
+    shape = _primitive_points("box", LEG)
+    frame = _leg_frame((_visual("box", LEG, LEG_FRAME, shape), _visual("box", LEG, other, shape)))
+    p_v, r_v = np.asarray(LEG_FRAME[0]), Rotation.from_quat(LEG_FRAME[1]).as_matrix()
+    r_l = Rotation.from_quat(poses[1]).as_matrix()
+    wrong = np.einsum("ij,tjk,nk->tni", r_v, r_l, shape) + (poses[0] @ r_v.T + p_v)[:, None, :]
+    verdict = judge(rec.recording([frame], [poses], [rec.track(wrong, label="leg_actor")]), checks=("attached",))["attached"]
+    assert not verdict.passed and verdict.diagnoses == ["visual-frame"], verdict.lines
+    right = rec.draw(*poses, Rotation.from_quat(LEG_FRAME[1]).apply(shape) + LEG_FRAME[0])
+    assert judge(rec.recording([frame], [poses], [rec.track(right, label="leg_actor")]), checks=("attached",))["attached"].passed
+
+
 def test_a_visual_shape_drawn_without_its_frame_is_named():
     placed = _drawn(_leg_frame(), _leg_in_link_frame(framed=False))
     assert not placed.passed and placed.diagnoses == ["visual-frame"], placed.lines

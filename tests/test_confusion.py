@@ -7,6 +7,8 @@ committed record are in ``test_discrimination`` (wrong syncs), ``test_examples``
 
 from __future__ import annotations
 
+import functools
+
 import pytest
 
 import order_syncs
@@ -23,6 +25,9 @@ pytestmark = pytest.mark.fury_free("verdicts and tables made by hand")
 def test_a_cell_is_right_none_or_the_wrong_name():
     assert confusion.cell("previous-step", "previous-step") == "right"
     assert confusion.cell("previous-step", "") == "none"
+    # a tie names neither of its two, and is wrong for any other mistake
+    assert confusion.cell("before-own-move", "late-or-own-move") == confusion.cell("previous-step", "late-or-own-move") == "none"
+    assert confusion.cell("wxyz", "late-or-own-move") == "other:late-or-own-move"
     assert confusion.cell("previous-step", "skipped") == "other:skipped"
     assert confusion.cell("-", "") == "right"  # outside the catalogue: silence is the right answer
     assert confusion.cell("-", "never-moved") == "other:never-moved"
@@ -124,3 +129,21 @@ def test_the_page_is_made_from_the_records_alone_and_a_run_without_either_is_ref
     assert "| syncs | FURY 0.12 | 1 | 1 (100 %) | 0 | 0 |" in text and "| syncs | FURY 2 | 1 | 0 (0 %) | 1 | 0 |" in text
     assert cli.main(["confusion"]) == 2
     assert "confusion: nothing to count: give a corpus" in capsys.readouterr().err
+
+
+def test_a_case_named_worse_than_its_record_fails_ci_and_one_as_good_passes(monkeypatch):
+    """The assertion CI holds every wrong sync, wrong app and zoo slice case to (tests/confusion_records.py):
+    right to none, none to a wrong name, and one wrong name for another fail; the same cell or a better one
+    passes; a case the record lacks may be silent but never named wrong."""
+    import confusion_records
+
+    monkeypatch.setattr(confusion_records, "recorded", lambda: {"apps": {"a.py": "right", "b.py": "none",
+                                                                         "c.py": "other:conjugate"}})
+    held = functools.partial(confusion_records.assert_named_no_worse, "apps", where="attached")
+    held("a.py", actual="wxyz", expected="wxyz")
+    held("b.py", actual="wxyz", expected="wxyz")
+    held("c.py", actual="conjugate", expected="wxyz")
+    held("new.py", actual="", expected="wxyz")
+    for item, actual in (("a.py", ""), ("b.py", "conjugate"), ("c.py", "turned-shape"), ("new.py", "conjugate")):
+        with pytest.raises(AssertionError, match=rf"{item} is named .*but should be named 'wxyz' .*\[apps, attached\]"):
+            held(item, actual=actual, expected="wxyz")

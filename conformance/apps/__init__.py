@@ -65,11 +65,18 @@ def reproduce_command(script: str, ticks: int, events=(), tick_function: str | N
 
 def check_app(script, *, ticks: int = DEFAULT_TICKS, events=(), tick_function=None, tolerance=None,
               timeout: float | None = None) -> AppResult:
-    """Run the app ``script`` under the kit and judge it (:func:`judge`)."""
+    """Run the app ``script`` under the kit and judge it (:func:`judge`); a failure whose run cannot tell a
+    late sync from one before the app's own moves gets a second, short run that can
+    (:mod:`~conformance.apps.told_apart`)."""
     from conformance.apps import launch
     from conformance.judge.tolerances import DEFAULT
 
     kwargs = {} if timeout is None else {"timeout": timeout}
     recording = launch.record(script, ticks=ticks, events=events, tick_function=tick_function, **kwargs)
-    return AppResult(str(script), ticks, list(events), recording, judge(recording, tolerance=tolerance or DEFAULT),
-                     tick_function)
+    result = AppResult(str(script), ticks, list(events), recording, judge(recording, tolerance=tolerance or DEFAULT),
+                       tick_function)
+    if not result.passed:
+        from conformance.apps import told_apart
+
+        told_apart.settle(result, reproduce=reproduce_command, timeout=timeout)
+    return result

@@ -542,23 +542,36 @@ ALIASES = {"radians-as-degrees, Euler": "radians-as-degrees", "visual-frame, ord
 
 
 def visual_order(positions: np.ndarray, rotations: np.ndarray, frames) -> tuple[np.ndarray, np.ndarray]:
-    """Each frame's pose ``(T, F, 3)``, ``(T, F, 3, 3)`` as a drawing shows it whose one visual frame ``(p_v,
-    R_v)`` is composed the wrong way round with the link's ``(p, R)`` (visual @ link where link @ visual is
-    meant): a point at ``x`` in the link frame is drawn at ``R_v R R_vᵀ (x - p_v) + p_v + R_v p``. A frame with
-    no visual frame, or several different ones, keeps its own pose (the mistake cannot be told by frame)."""
+    """Each frame's pose ``(T, F, 3)``, ``(T, F, 3, 3)`` as a drawing shows it whose one visual frame is
+    composed the wrong way round with the link's (:func:`visual_order_of`). A frame with no visual frame, or
+    several different ones, keeps its own pose (the judge tries those one by one, :func:`visual_frames`)."""
     positions, rotations = np.array(positions, dtype=np.float64), np.array(rotations, dtype=np.float64)
     for index, frame in enumerate(frames):
-        placed = {(tuple(np.round(v[2], 9)), tuple(np.round(v[3], 9))) for v in getattr(frame, "visuals", ())}
+        placed = visual_frames(frame)
         if len(placed) != 1:
             continue
-        p_v, q_v = (np.asarray(a, dtype=np.float64) for a in next(iter(placed)))
-        r_v = Rotation.from_quat(q_v).as_matrix()
-        if np.linalg.norm(p_v) < 1e-9 and np.allclose(r_v, np.eye(3)):
-            continue
-        turned = np.einsum("ij,tjk,lk->til", r_v, rotations[:, index], r_v)
-        positions[:, index] = p_v + positions[:, index] @ r_v.T - turned @ p_v
-        rotations[:, index] = turned
+        positions[:, index], rotations[:, index] = visual_order_of(positions[:, index], rotations[:, index], *placed[0])
     return positions, rotations
+
+
+def visual_frames(frame) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The distinct visual frames ``(p_v, q_v)`` of a frame's visual shapes that are not the identity."""
+    placed = {(tuple(np.round(v[2], 9)), tuple(np.round(v[3], 9))) for v in getattr(frame, "visuals", ())}
+    found = []
+    for p_v, q_v in sorted(placed):
+        p_v, q_v = np.asarray(p_v, dtype=np.float64), np.asarray(q_v, dtype=np.float64)
+        if np.linalg.norm(p_v) >= 1e-9 or abs(abs(q_v[3]) - 1) > 1e-9:
+            found.append((p_v, q_v))
+    return found
+
+
+def visual_order_of(positions: np.ndarray, rotations: np.ndarray, p_v, q_v) -> tuple[np.ndarray, np.ndarray]:
+    """One frame's pose ``(T, 3)``, ``(T, 3, 3)`` as a drawing shows it whose visual frame ``(p_v, q_v)`` is
+    composed the wrong way round with the link's ``(p, R)`` (visual @ link where link @ visual is meant): a point
+    at ``x`` in the link frame is drawn at ``R_v R R_vᵀ (x - p_v) + p_v + R_v p``."""
+    r_v = Rotation.from_quat(q_v).as_matrix()
+    turned = np.einsum("ij,tjk,lk->til", r_v, rotations, r_v)
+    return p_v + positions @ r_v.T - turned @ p_v, turned
 
 
 def variant_fit(vertices: np.ndarray, positions: np.ndarray, rotations: np.ndarray, reference: np.ndarray,

@@ -171,7 +171,7 @@ class _Judgement:
         self.followed_badly.clear()
         verdict = Verdict("attached", True)
         worst = 0.0
-        for track, a, mapped in zip(self.r.actors, self.attachments, self.mapped):
+        for index, (track, a, mapped) in enumerate(zip(self.r.actors, self.attachments, self.mapped)):
             ratio = np.max(a.error / a.allowance[:, None], axis=1, initial=0)
             loose = ~a.held & ~mapped
             tied = int(a.tied.sum())
@@ -197,6 +197,8 @@ class _Judgement:
                     soft.setdefault((info.client, info.body, info.name, diagnosis), []).append(
                         soft_bodies.Piece(rows, error[:, first].max(), first, error[:, k].max(), k, allowance.max()))
                     continue
+                if diagnosis == "late-or-own-move":
+                    verdict.ties.append((index, start, stop, frame))
                 verdict.lines.append(
                     f"{track.label} ({track.kind}) vertices {start}:{stop} of {len(a.frame)}: not held by any frame; "
                     f"follows {self.frame_label(frame)} best, and left it at tick {first + 1}: "
@@ -251,6 +253,8 @@ class _Judgement:
             if other >= 0 and other != frame and np.all(held <= allowance[:, None]):
                 line += f"; they are held by {self.frame_label(other)} instead"
                 diagnosis = "other-body"
+        if diagnosis == "late-or-own-move":
+            verdict.ties.append((entry["actor"], int(rows[0]), int(rows[-1]) + 1, frame))
         verdict.lines.append(line)
         verdict.diagnosed(diagnosis)
 
@@ -355,7 +359,22 @@ class _Judgement:
                         vertices, positions, rotations, reference, allowance, np.arange(len(vertices))):
                     return "skipped"
                 return attach_mod.ALIASES.get(name, name)
+        if self._visual_order_fits(vertices, frame, reference, allowance, bad_ticks):
+            return "visual-frame"
         return "skipped" if self._skipped(vertices, frame, allowance) else ""
+
+    def _visual_order_fits(self, vertices, frame, reference, allowance, bad_ticks) -> bool:
+        """Whether one of the frame's several visual frames, composed the wrong way round with its pose, holds
+        the vertices: one actor per visual shape posed by ``visual @ link`` (the catalogue's variant covers a
+        frame with one visual frame; a robot's link often has several)."""
+        placed = attach_mod.visual_frames(self.r.frames[frame]) if frame < len(self.r.frames) else []
+        if len(placed) < 2:
+            return False
+        for p_v, q_v in placed:
+            positions, rotations = attach_mod.visual_order_of(self.pos[:, frame], self.rot[:, frame], p_v, q_v)
+            if attach_mod.variant_fit(vertices, positions[:, None], rotations[:, None], reference, allowance, bad_ticks):
+                return True
+        return False
 
     @functools.cached_property
     def _poses_before_writes(self) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
@@ -380,9 +399,11 @@ class _Judgement:
 
     def _before_own_move(self, vertices, frame, reference, allowance, bad_ticks) -> str:
         """``"before-own-move"`` when the vertices sit, at the failing ticks, where the frame was after the step
-        and before the app's own moves of that tick (``resetJointState`` of a playback), closer than at its pose
-        before the step: the sync ran between them. Both may fit when a step moves a body less than the
-        allowance (a kinematic arm): the nearer names the mistake."""
+        and before the app's own moves of that tick (``resetJointState`` of a playback), and not at its pose
+        before the step: the sync ran between them. Where both poses hold them (a step that moves a kinematic
+        arm less than the allowance: after ``resetJointState`` a step leaves its joints exactly where they
+        were, measured) this run cannot tell the two mistakes apart: ``"late-or-own-move"``, which
+        :mod:`~conformance.apps.told_apart` settles with a run of its own."""
         before = self._poses_before_writes
         if before is None or not before[2][:, frame].any() or not len(bad_ticks):
             return ""
@@ -392,11 +413,20 @@ class _Judgement:
             return ""
         late = list(attach_mod.VARIANTS).index("previous-step")
         late_pos, late_rot = (a[:, frame, None] for a in self._variants[late])
+        if not attach_mod.variant_fit(vertices, late_pos, late_rot, reference, allowance, bad_ticks):
+            return "before-own-move"
+        own = attach_mod.local_coordinates(vertices[bad_ticks], positions[bad_ticks], rotations[bad_ticks])
+        behind = attach_mod.local_coordinates(vertices[bad_ticks], late_pos[bad_ticks], late_rot[bad_ticks])
+        apart = float(np.max(np.linalg.norm(own - behind, axis=-1), initial=0.0))
+        if apart <= float(np.max(allowance)):
+            # A late sync is late wherever the body moved; drawn right at some of those ticks, it skipped
+            if not attach_mod.variant_fit(vertices, positions, rotations, reference, allowance, np.arange(len(vertices))):
+                return "skipped"
+            return "late-or-own-move"
 
-        def worst(pos, rot):
-            local = attach_mod.local_coordinates(vertices[bad_ticks], pos[bad_ticks], rot[bad_ticks])
+        def worst(local):
             return float(np.max(np.linalg.norm(local - reference, axis=-1)))
-        return "before-own-move" if worst(positions, rotations) < worst(late_pos, late_rot) else ""
+        return "before-own-move" if worst(own) < worst(behind) else ""
 
     def _later_than_the_step(self, vertices, frame, reference) -> str:
         """:meth:`_before_own_move` for a piece :meth:`_owners` found a step late."""
@@ -590,9 +620,10 @@ class _Judgement:
         at_its_size = {frame for _, _, frame, _, result in self.placements() if result.judged}
         if self._drawn_verdict is None:
             self.drawn()  # which still vertices are a moving link left where it was built (self.left_behind)
+        index = {id(track): k for k, track in enumerate(self.r.actors)}
         for track, a, frame, rows, result in self.placements():
             info = self.r.frames[frame]
-            left = self.left_behind.get(next(k for k, t in enumerate(self.r.actors) if t is track), set())
+            left = self.left_behind.get(index[id(track)], set())
             if left and left.intersection(rows.tolist()):
                 rows = np.array([r for r in rows if r not in left], dtype=int)
                 if not len(rows):

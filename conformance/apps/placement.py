@@ -205,12 +205,16 @@ def candidates(shapes, mesh=(), visuals=()) -> list[tuple[str, str, np.ndarray, 
 def _mistakes(visuals) -> list[tuple[str, np.ndarray, np.ndarray]]:
     """What a drawing of a frame's visual shapes spans when their usual mistakes are made, ``(diagnosis,
     centre, half)``, for each shape and for all of them together: drawn without its visual frame
-    (``getVisualShapeData(...)[5:7]`` left out), a mesh drawn without its scale."""
-    unframed, unscaled, factors = [], [], set()
+    (``getVisualShapeData(...)[5:7]`` left out) or with its turn and offset composed the wrong way round (the
+    offset turned too), a mesh drawn without its scale."""
+    unframed, swapped, unscaled, factors = [], [], [], set()
     for kind, dims, position, orientation, points in visuals:
         own = np.asarray(points, dtype=np.float64)
-        framed = np.linalg.norm(position) > 1e-9 or abs(abs(orientation[3]) - 1) > 1e-9
-        unframed.append(own if framed else None)
+        moved, turned = np.linalg.norm(position) > 1e-9, abs(abs(orientation[3]) - 1) > 1e-9
+        unframed.append(own if moved or turned else None)
+        # The visual frame's own two parts composed the wrong way round, turned after its offset: R_v (x + p_v)
+        turn = Rotation.from_quat(orientation).as_matrix()
+        swapped.append((own + np.asarray(position)) @ turn.T if moved and turned else None)
         scale = np.asarray(dims[:3], dtype=np.float64)
         scaled = kind == "mesh" and np.all(scale > 0) and np.any(np.abs(scale - 1) > 1e-6)
         unscaled.append(_framed((kind, dims, position, orientation, own / scale)) if scaled else None)
@@ -221,7 +225,8 @@ def _mistakes(visuals) -> list[tuple[str, np.ndarray, np.ndarray]]:
     # apart, so it is named by what it shows, "scaled", with the factor. One that differs by axis is the mesh's.
     uniform = len(factors) == 1 and 0.0 not in factors
     found = []
-    for diagnosis, wrong in (("visual-frame", unframed), ("scaled" if uniform else "mesh-scale", unscaled)):
+    for diagnosis, wrong in (("visual-frame", unframed), ("visual-frame", swapped),
+                             ("scaled" if uniform else "mesh-scale", unscaled)):
         if not any(w is not None for w in wrong):
             continue
         factor = next(iter(factors)) if diagnosis == "scaled" else 0.0
@@ -336,7 +341,8 @@ def _uniform_scale(drawn_half: np.ndarray, half: np.ndarray, rtol: float) -> flo
 
 
 #: How each mistaken drawing of a visual shape is told.
-_MISTAKEN = {"visual-frame": "without its visual frame (getVisualShapeData(...)[5:7])",
+_MISTAKEN = {"visual-frame": "without its visual frame, or with its turn and offset composed the wrong way round "
+                             "(getVisualShapeData(...)[5:7])",
              "mesh-scale": "without its mesh scale (getVisualShapeData(...)[3])"}
 
 

@@ -22,7 +22,8 @@ DIAGNOSES = {name: text for name, (text, _) in attach_mod.VARIANTS.items() if na
                    "undone twice): the link frame is the centre of mass moved by minus getDynamicsInfo(body, link)[3:5], "
                    "turned by the centre of mass's orientation",
     "visual-frame": "drawn without its visual frame, or with it composed the wrong way round (visual @ link where "
-                    "link @ visual is meant): a URDF places each visual shape in its link frame "
+                    "link @ visual is meant, or its offset turned by its own rotation: R_v (x + p_v) where R_v x + p_v "
+                    "is meant): a URDF places each visual shape in its link frame "
                     "(getVisualShapeData(body)[i][5:7], the <visual><origin>), which the actor must be moved by, "
                     "after the link's pose",
     "mesh-scale": "drawn without its mesh scale: getVisualShapeData(body)[i][3] (the URDF's <mesh scale>) scales the "
@@ -35,6 +36,11 @@ DIAGNOSES = {name: text for name, (text, _) in attach_mod.VARIANTS.items() if na
     "before-own-move": "drawn at the pose pyBullet held after the tick's step but before the app's own moves of that "
                        "tick (resetJointState, resetBasePositionAndOrientation: a playback, a teleport): the sync runs "
                        "between them; draw after the app's own moves, at the end of the tick",
+    "late-or-own-move": "drawn at the pose of the tick before, which pyBullet still held after this tick's step (a "
+                        "step leaves a joint just reset where it was): the sync runs before p.stepSimulation(), or "
+                        "after it but before the app's own moves of the tick (resetJointState, "
+                        "resetBasePositionAndOrientation), and no run could tell which: draw at the end of the tick, "
+                        "after the step and the app's own moves",
     "stale-normals": "the vertices turn but the stored normals do not: turn normals with the same rotation",
     "unannounced": "vertex data changed without telling the renderer, which keeps drawing the old data: call "
                    "utils.update_actor (FURY 0.12); on FURY 2 call update_range (or update_full) on every buffer "
@@ -72,7 +78,7 @@ DIAGNOSES = {name: text for name, (text, _) in attach_mod.VARIANTS.items() if na
 #: shape's size and frame; then the generic ones, which say where a drawing is and not why: a link scaled 1.6
 #: times is also "not its shape" in the picture and "follows another body" where its vertices left their link.
 #: Measured on the zoo's injected mistakes (``python -m conformance confusion``, docs/confusion.md).
-LEAD_ORDER = ("before-own-move", "skipped", "previous-step", "wxyz", "scalar-first", "euler-order", "radians-as-degrees",
+LEAD_ORDER = ("before-own-move", "late-or-own-move", "skipped", "previous-step", "wxyz", "scalar-first", "euler-order", "radians-as-degrees",
               "float32-angle-axis", "conjugate", "translation-only", "written-back", "unannounced", "stale-gpu",
               "node-order", "face-order", "stale-normals", "hidden", "scaled", "mesh-scale", "com-frame", "visual-frame",
               "offset-sign", "turned-shape", "never-moved", "other-body", "not-its-shape")
@@ -103,6 +109,9 @@ class Verdict:
     notes: list = field(default_factory=list)
     #: (ImageCheck, pictures by role) of each picture compared (``pictured``): the artefacts to keep
     pictures: list = field(default_factory=list)
+    #: (actor index, start, stop, frame) of each piece named ``late-or-own-move`` (``attached``): where
+    #: :mod:`~conformance.apps.told_apart` looks in its telling run
+    ties: list = field(default_factory=list)
 
     def message(self) -> str:
         return "\n".join(self.lines)

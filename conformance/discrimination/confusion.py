@@ -48,7 +48,8 @@ class Case:
 
 
 #: Names that say two mistakes cannot be told apart yet: none of the two is named, and neither is wrong.
-UNDECIDED = {"late-or-once": {"previous-step", "never-moved"}}
+UNDECIDED = {"late-or-once": {"previous-step", "never-moved"},
+             "late-or-own-move": {"previous-step", "before-own-move"}}
 
 
 def cell(expected: str, named: str) -> str:
