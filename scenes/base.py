@@ -78,6 +78,9 @@ class Surface:
 
     faces: tuple[tuple[int, int, int], ...]
     color: tuple[float, float, float] = (0.8, 0.8, 0.8)
+    #: the file's vertices as written, unscaled and unmoved: what pyBullet's visual mesh of the body holds
+    #: until its first step (``getMeshData`` without ``MESH_DATA_SIMULATION_MESH``, one vertex per face corner)
+    file_vertices: np.ndarray | None = field(default=None, compare=False, repr=False)
     kind = "surface"
 
     def __post_init__(self):
@@ -283,7 +286,7 @@ class Scene:
                              f"file's {len(vertices)} vertices in order, so the file's faces cannot draw it")
         for node in anchors:
             self.p.createSoftBodyAnchor(body, int(node), -1, -1)
-        self.bind(name, body, -1, Surface(faces=faces, color=color))
+        self.bind(name, body, -1, Surface(faces=faces, color=color, file_vertices=vertices))
         return body
 
     def bind(self, name: str, body: int, link: int, shape: Shape | Surface, *, actor: str | None = None) -> Binding:

@@ -10,11 +10,14 @@ from __future__ import annotations
 
 import numpy as np
 
+import pybullet
+
 from conformance.bullet import truth
 from conformance.implementations.frames import SoftBodies
 from conformance.implementations.reference import ReferenceSync
 
-__all__ = ["CopiedOnce", "Float16Nodes", "MovesTheCloth", "NodesReversed", "OneStepLateNodes", "PartlyCopied"]
+__all__ = ["CopiedOnce", "Float16Nodes", "MovesTheCloth", "NodesReversed", "OneStepLateNodes", "PartlyCopied",
+           "VisualMesh"]
 
 
 class _LateNodes(SoftBodies):
@@ -104,6 +107,23 @@ class Float16Nodes(ReferenceSync):
     """
 
     soft_bodies = _Float16
+
+
+class _Visual(SoftBodies):
+    def vertices(self, t, nodes):
+        # getMeshData without MESH_DATA_SIMULATION_MESH: the visual mesh, one vertex per corner of each face
+        visual = pybullet.getMeshData(t.body, -1, physicsClientId=self.client)[1]
+        return np.asarray(visual, dtype=np.float64)[t.nodes]
+
+
+class VisualMesh(ReferenceSync):
+    """Wrong: reads the soft body with ``getMeshData(body)`` (no ``MESH_DATA_SIMULATION_MESH`` flag), pyBullet's
+    visual mesh, and copies its first vertices: they are the corners of the first faces, not the nodes in order.
+
+    Diagnosis: visual-mesh
+    """
+
+    soft_bodies = _Visual
 
 
 class MovesTheCloth(ReferenceSync):

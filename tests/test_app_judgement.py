@@ -500,6 +500,43 @@ def test_a_playback_whose_step_moves_nothing_names_neither_mistake_alone(drawn):
     assert "before p.stepSimulation()" in verdict.message() and "own moves" in verdict.message()
 
 
+def _arm_played_back(drawn_before_reset: bool, bodies: int = 6):
+    """Kinematic playback of ``bodies`` boxes whose drawings (64 points each) lie 1.2 m from their frames'
+    origins, past twice their collision shapes' reach and nearer other frames (a robot's meshes about joints
+    crowded together); one shared actor, each tick drawn at the end or before the app's own moves."""
+    rng = np.random.default_rng(7)
+    frames, poses, drawings, writes = [], [], [], []
+    velocities = np.zeros((TICKS + 1, 6))
+    for body in range(bodies):
+        trajectory, turns = motion(seed=body, offset=(0.05 * body, 0.0, 0.0))
+        before = (np.concatenate([trajectory[:1], trajectory[:-1] + [0.0, 0.0, -2e-4]]),
+                  np.concatenate([turns[:1], turns[:-1]]))
+        geometry = rng.normal(scale=0.05, size=(64, 3)) + Rotation.random(random_state=body).apply([1.2, 0.0, 0.0])
+        frames.append(box_frame(body))
+        poses.append((trajectory, turns))
+        drawings.append(draw(*(before if drawn_before_reset else (trajectory, turns)), geometry))
+        writes.append(np.concatenate([*before, velocities, trajectory, turns, velocities], axis=-1))
+    made = recording(frames, poses, [track(np.concatenate(drawings, axis=1), label="arm")])
+    made.writes = np.stack(writes, axis=1)
+    made.writes[0] = np.nan
+    made.writers = [[]] + [["resetJointState"]] * TICKS
+    return made
+
+
+def test_a_playback_drawn_before_its_reset_is_one_piece_a_link_each_named():
+    """A robot played back and drawn before each tick's own ``resetJointState`` is named so for every link, in
+    one line a link, though its meshes lie nearer other links' frames than their own (issue 47: the zoo's
+    Franka fell apart into 1,568 lines, judged in 2.5 times its right twin's time). Drawn at the end, it
+    passes."""
+    assert judge(_arm_played_back(False))["attached"].passed
+    verdict = judge(_arm_played_back(True))["attached"]
+    assert not verdict.passed and len(verdict.lines) == 2 * 6, verdict.message()
+    # A link that barely turns is held by the pose before the step at a place of its own, 0.2 mm from the
+    # other's: this run cannot tell which is the drawing's (told_apart's run does), and says both.
+    assert set(verdict.diagnoses) <= {"before-own-move", "late-or-own-move"}, verdict.message()
+    assert verdict.diagnoses.count("before-own-move") >= 4, verdict.message()
+
+
 def test_a_link_never_posed_left_at_the_origin_is_named_never_moved():
     """Issue 48: a body whose actor is built in its link frame and never posed (the sync skips it) stays at the
     world's origin, far from where the body starts: ``drawn`` fails and names it, as for one left where the

@@ -30,12 +30,40 @@ def kit(spec: str) -> Kit:
     ("soft_syncs:CopiedOnce", 1, r"drawn at the soft body's nodes as built.*\(told at frame 2: at frame 1 the two draw alike\)"),
     ("soft_syncs:PartlyCopied", 1, r"only \d+ of the soft body's \d+ vertices follow its nodes"),
     ("soft_syncs:Float16Nodes", 0, "drawn at the soft body's nodes rounded to float16"),
+    ("soft_syncs:VisualMesh", 0, r"drawn at the soft body's visual mesh \(getMeshData without MESH_DATA_SIMULATION_MESH"),
 ])
 def test_every_frame_check_fails_on_a_wrong_soft_body(spec, frame, diagnosis, scene_name):
     body = "cloth" if scene_name == "cloth" else "ball"
     with pytest.raises(Failed, match=rf"'{body}' \(body \d\) vertex \d+ is drawn at .* but should be at .*: error .* > tolerance "
                                      rf".*\[{scene_name}\(.*frame {frame}, .*\ndiagnosis: .*{diagnosis}.*\nreproduce: "):
         checks.test_vertices_match_poses_every_frame(scene_name, kit(spec))
+
+
+@pytest.mark.parametrize("scene_name", ["cloth", "soft_ball"])
+def test_the_visual_mesh_a_diagnosis_expects_is_pybullets(scene_name):
+    """The ``visual-mesh`` diagnosis (a sync that reads ``getMeshData`` without ``MESH_DATA_SIMULATION_MESH``) takes
+    pyBullet's visual mesh of a soft body loaded from a mesh file for each face's corners in the file's order,
+    and before the first step for the file's vertices as written: so it is, to the bit, at frame 0, after the
+    first step and once the body has moved."""
+    import types
+
+    import pybullet
+
+    from conformance.judge import diagnosis
+
+    scene = scenes.build(scene_name)
+    try:
+        index = next(i for i, b in enumerate(scene.bindings) if b.soft)
+        body = scene.bindings[index].body
+        for frame, steps in ((0, 0), (1, 1), (40, 39)):
+            scene.run(steps)
+            nodes = truth.nodes(scene.p, body)
+            predicted = diagnosis._visual_mesh(types.SimpleNamespace(scene=scene), index, nodes, frame)
+            visual = np.asarray(pybullet.getMeshData(body, -1, physicsClientId=scene.p.client)[1], dtype=np.float64)
+            assert predicted is not None and predicted.shape == visual.shape and len(visual) > len(nodes)
+            assert np.array_equal(predicted, visual), frame
+    finally:
+        scene.close()
 
 
 @pytest.mark.parametrize("spec, words", [

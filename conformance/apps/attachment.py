@@ -136,11 +136,15 @@ def _errors(local: np.ndarray, still: np.ndarray | None = None) -> np.ndarray:
 
 def _spreads(vertices, positions, rotations, candidates, probes):
     """Largest change of each vertex's coordinates over the ``probes`` ticks, in each candidate frame:
-    ``(n, k)`` for ``candidates`` ``(n, k)`` frame indices (computed frame by frame, as :func:`_in_frames`)."""
+    ``(n, k)`` for ``candidates`` ``(n, k)`` frame indices (computed frame by frame, as :func:`_in_frames`); a
+    pair whose frame is -1 is not computed: infinity."""
     v, p, r = vertices[probes], positions[probes], rotations[probes]
     out = np.empty(candidates.shape)
     for f in np.unique(candidates):
         rows, cols = np.nonzero(candidates == f)
+        if f < 0:  # a pair not asked for
+            out[rows, cols] = np.inf
+            continue
         local = in_frame(v[:, rows], p[:, f], r[:, f])
         out[rows, cols] = np.max(_lengths(local - local[:1]), axis=0)
     return out
@@ -243,13 +247,26 @@ def attach(vertices: np.ndarray, positions: np.ndarray, rotations: np.ndarray, *
         loose = rows[np.any(error[rows] > allowance[rows, None], axis=1)]
         if len(loose):
             again = np.concatenate([nearest(loose, min(frames, NEAREST)), best[loose, None]], axis=1)
-            found = spreads_of(loose, again, np.arange(ticks))
+            limit = _allowances_in(vertices, pos, rot, best, again, tolerance)
+            # A spread over the probe ticks (tick 0 among them) is at most the spread over every tick: the
+            # frame nearest on the probes gives the smallest spread an upper bound, and a frame whose probe
+            # spread is above that bound and its own allowance can neither hold the vertex nor come nearest.
+            # The same choice as every frame's spread over every tick, at a fraction of the cost on a wrong
+            # drawing, where every vertex is loose (a racecar drawn before its own resets: most of its judging).
+            bound = spreads_of(loose, again)
+            rows = np.arange(len(loose))
+            first = np.argmin(bound, axis=1)
+            upper = spreads_of(loose, again[rows, first, None], np.arange(ticks))[:, 0]
+            wanted = bound <= np.maximum(upper[:, None], limit)
+            wanted[rows, first] = False
+            found = spreads_of(loose, np.where(wanted, again, -1), np.arange(ticks))
+            found[rows, first] = upper
             # Held means within the allowance of the frame that holds it, and frames' allowances differ: a
             # chassis vertex on a front wheel's axle lies at the wheel's origin, so the wheel carries it a
             # float32 hair closer than the chassis does (1.6e-7 m against 2.0e-7) while only the chassis,
             # whose extent it is drawn from, allows that hair (the app precision measurement, FURY 2's
             # racecar, seed 10). A frame that holds it is chosen over one that comes closer but does not.
-            ratio = found / _allowances_in(vertices, pos, rot, best, again, tolerance)
+            ratio = found / limit
             pick = np.where(np.any(ratio <= 1, axis=1), np.argmin(ratio, axis=1), np.argmin(found, axis=1))
             best[loose] = again[np.arange(len(loose)), pick]
             allowance = _allowance(vertices, pos, rot, best, tolerance)
@@ -576,15 +593,17 @@ def visual_order_of(positions: np.ndarray, rotations: np.ndarray, p_v, q_v) -> t
 
 def variant_fit(vertices: np.ndarray, positions: np.ndarray, rotations: np.ndarray, reference: np.ndarray,
                 allowance: np.ndarray, ticks: np.ndarray) -> bool:
-    """Whether the vertices ``(T, m, 3)`` sit at ``reference`` (or at one fixed place of their own) in the
-    frames ``(T, m, 3)``/``(T, m, 3, 3)`` at every tick of ``ticks`` (indices), within ``allowance``."""
+    """Whether the vertices ``(T, m, 3)`` sit at ``reference`` (or at one fixed place of their own; only
+    there when ``reference`` is None) in the frames ``(T, m, 3)``/``(T, m, 3, 3)`` at every tick of ``ticks``
+    (indices), within ``allowance``."""
     # Each vertex passes or fails on its own, so one vertex that fits neither place rules the variant out at
     # the cost of one vertex: most variants tried on a wrong drawing fail so (a third of judging a robot
     # drawn with degrees for radians).
     one = slice(0, 1)
     first = local_coordinates(vertices[ticks, one], positions[ticks, one], rotations[ticks, one])
     own = np.median(local_coordinates(vertices[:, one], positions[:, one], rotations[:, one]), axis=0)
-    places = [ref for ref, at in ((reference, reference[one]), (None, own))
+    candidates = ((None, own),) if reference is None else ((reference, reference[one]), (None, own))
+    places = [ref for ref, at in candidates
               if np.all(np.linalg.norm(first - at, axis=-1) <= allowance[one])]
     if not places:
         return False
