@@ -254,13 +254,13 @@ def attach(vertices: np.ndarray, positions: np.ndarray, rotations: np.ndarray, *
             # The same choice as every frame's spread over every tick, at a fraction of the cost on a wrong
             # drawing, where every vertex is loose (a racecar drawn before its own resets: most of its judging).
             bound = spreads_of(loose, again)
-            rows = np.arange(len(loose))
+            each = np.arange(len(loose))
             first = np.argmin(bound, axis=1)
-            upper = spreads_of(loose, again[rows, first, None], np.arange(ticks))[:, 0]
+            upper = spreads_of(loose, again[each, first, None], np.arange(ticks))[:, 0]
             wanted = bound <= np.maximum(upper[:, None], limit)
-            wanted[rows, first] = False
+            wanted[each, first] = False
             found = spreads_of(loose, np.where(wanted, again, -1), np.arange(ticks))
-            found[rows, first] = upper
+            found[each, first] = upper
             # Held means within the allowance of the frame that holds it, and frames' allowances differ: a
             # chassis vertex on a front wheel's axle lies at the wheel's origin, so the wheel carries it a
             # float32 hair closer than the chassis does (1.6e-7 m against 2.0e-7) while only the chassis,
@@ -268,7 +268,7 @@ def attach(vertices: np.ndarray, positions: np.ndarray, rotations: np.ndarray, *
             # racecar, seed 10). A frame that holds it is chosen over one that comes closer but does not.
             ratio = found / limit
             pick = np.where(np.any(ratio <= 1, axis=1), np.argmin(ratio, axis=1), np.argmin(found, axis=1))
-            best[loose] = again[np.arange(len(loose)), pick]
+            best[loose] = again[each, pick]
             allowance = _allowance(vertices, pos, rot, best, tolerance)
             again_in(loose)
 

@@ -40,6 +40,9 @@ CHECKS = ("runs", "attached", "drawn", "placed", "normals", "announced", "untouc
 UNTOUCHED_ATOL = 1e-12
 #: pyBullet's calls that set a pose (a write-back writes one): the driver's STATE_WRITERS but resetBaseVelocity
 POSE_WRITERS = {"resetBasePositionAndOrientation", "resetJointState", "resetJointStateMultiDof", "resetJointStatesMultiDof"}
+#: :meth:`_Judgement._owners`' mistake index of the pose before the app's own moves: one past the catalogue
+_OWN_MOVE = len(attach_mod.VARIANTS) + 1
+
 
 def _rotations(q: np.ndarray) -> np.ndarray:
     return Rotation.from_quat(q.reshape(-1, 4)).as_matrix().reshape(q.shape[:-1] + (3, 3))
@@ -264,7 +267,6 @@ class _Judgement:
         under a known mistake (or, when none does, that it follows best), and consecutive vertices with the
         same frame and mistake make one piece."""
         pieces = []
-        own_move = len(attach_mod.VARIANTS) + 1  # _owners' index of the pose before the app's own moves
         late = list(attach_mod.VARIANTS).index("previous-step") + 1
 
         def add(piece, frame, diagnosis):
@@ -279,29 +281,30 @@ class _Judgement:
             # Where a joint reset barely moved a link, the poses before the step and before the app's own
             # moves both hold its vertices, and each vertex went to the nearer by a hair: a mini cheetah's thigh
             # in 377 runs of the two. Told on the whole run; where that names nothing, run by run as found.
-            merged = np.where(mistakes == late, own_move, mistakes)
-            for s, e in _runs(np.ones(len(rows), dtype=bool), frames * (own_move + 1) + merged):
-                piece, kinds = rows[s:e], set(mistakes[s:e].tolist())
-                if kinds == {late, own_move}:
-                    frame = int(frames[s])
-                    reference = a.reference[piece] if np.all(a.frame[piece] == frame) else None
-                    diagnosis = self._later_than_the_step(track.vertices[1:, piece], frame, reference)
+            merged = np.where(mistakes == late, _OWN_MOVE, mistakes)
+            for s, e in _runs(np.ones(len(rows), dtype=bool), frames * (_OWN_MOVE + 1) + merged):
+                piece, frame = rows[s:e], int(frames[s])
+                if set(mistakes[s:e].tolist()) == {late, _OWN_MOVE}:
+                    diagnosis = self._own_move_of(track, a, piece, frame)
                     if diagnosis:
                         add(piece, frame, diagnosis)
                         continue
                 for s2, e2 in _runs(np.ones(e - s, dtype=bool), mistakes[s:e]):
-                    part = piece[s2:e2]
-                    add(part, *self._piece(track, a, part, int(frames[s]), int(mistakes[s + s2]), own_move))
+                    add(piece[s2:e2], *self._piece(track, a, piece[s2:e2], frame, int(mistakes[s + s2])))
         return pieces
 
-    def _piece(self, track, a, piece, frame: int, mistake: int, own_move: int) -> tuple[int, str]:
+    def _own_move_of(self, track, a, piece, frame: int) -> str:
+        """:meth:`_later_than_the_step` of a piece :meth:`_owners` gave to ``frame``, which may not be the one the
+        attachment found for it: the reference is where the drawing sits in that one, of no use in another."""
+        reference = a.reference[piece] if np.all(a.frame[piece] == frame) else None
+        return self._later_than_the_step(track.vertices[1:, piece], frame, reference)
+
+    def _piece(self, track, a, piece, frame: int, mistake: int) -> tuple[int, str]:
         """The frame and diagnosis of a run of loose vertices that :meth:`_owners` gave to ``frame`` under
-        ``mistake`` (0 none, ``own_move`` the pose before the app's own moves)."""
+        ``mistake`` (0 none, :data:`_OWN_MOVE` the pose before the app's own moves)."""
         vertices = track.vertices[1:, piece]
-        if mistake == own_move:
-            # The reference is where the drawing sits in the frame that held it best: of no use in another
-            reference = a.reference[piece] if np.all(a.frame[piece] == frame) else None
-            diagnosis = self._later_than_the_step(vertices, frame, reference)
+        if mistake == _OWN_MOVE:
+            diagnosis = self._own_move_of(track, a, piece, frame)
             return (frame, diagnosis) if diagnosis else self._followed(vertices, a.frame[piece], a.reference[piece])
         if mistake:
             diagnosis = list(attach_mod.VARIANTS)[mistake - 1]
@@ -337,11 +340,10 @@ class _Judgement:
         near_own = np.zeros_like(near)
         if before is not None:
             near_own[:] = before[2].any(axis=0)[None, :]
-        own_move = len(self._variants) + 1
         for f in np.flatnonzero(near.any(axis=0) | near_own.any(axis=0)):
             poses = list(self._variants) + ([before[:2]] if near_own[:, f].any() else [])
             for k, (positions, rotations) in enumerate(poses, start=1):
-                near_f = np.flatnonzero(near_own[:, f] if k == own_move else near[:, f])
+                near_f = np.flatnonzero(near_own[:, f] if k == _OWN_MOVE else near[:, f])
                 if not len(near_f):
                     continue
                 # Held within the allowance of one place at every tick means within twice it of the first
