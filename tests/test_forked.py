@@ -12,6 +12,7 @@ import subprocess
 import sys
 import textwrap
 import time
+from pathlib import Path
 
 import pytest
 
@@ -123,3 +124,50 @@ def test_what_is_forked_for_a_killed_kit_ends_with_it(what, tmp_path, env):
         if pidfile.exists() and pidfile.read_text():
             with contextlib.suppress(ProcessLookupError):
                 os.kill(int(pidfile.read_text()), signal.SIGKILL)
+
+
+#: a check that kills the fork server it was forked from (its parent), then fails
+KILLS_ITS_SERVER = textwrap.dedent("""
+    import os, signal, time
+
+    def test_kills_its_server_then_fails():
+        os.kill(os.getppid(), signal.SIGKILL)
+        time.sleep(0.5)  # the caller reads the server's end of file now, while this run goes on
+        assert False
+""")
+
+#: an app that kills the fork server it was forked from, then runs as the kit's box app does
+APP_KILLS_ITS_SERVER = textwrap.dedent("""
+    import os, runpy, signal, time
+
+    os.kill(os.getppid(), signal.SIGKILL)
+    time.sleep(0.5)
+    runpy.run_path({box!r}, run_name="__main__")
+""")
+
+#: a caller that prints what the kit made of its forked run
+SERVER_KILLED_CALLERS = {
+    "pytest run": "from conformance.discrimination import forked; import os; "
+                  "print(forked.run(['test_kills.py', '-q', '-p', 'no:cacheprovider'], env=dict(os.environ)).returncode)",
+    "app": "from conformance.apps import launch; launch.record('app_kills.py', ticks=3); print('recorded')",
+}
+
+
+@pytest.mark.parametrize("what", sorted(SERVER_KILLED_CALLERS))
+def test_a_run_whose_fork_server_dies_keeps_its_own_exit_status(what, tmp_path, env):
+    """multiprocessing reads 255 for a process whose fork server ended first, whatever the process did (a
+    wrong sync's forked run read 255 in CI though its pytest run ended with 1): the kit waits for the process
+    itself and goes by the status it wrote."""
+    if launch.server() is None:
+        pytest.skip("no forkserver on this platform: the kit starts a new process instead")
+    from conformance import backends
+
+    box = Path(__file__).parent / "apps" / f"box_{backends.NAME}.py"
+    (tmp_path / "test_kills.py").write_text(KILLS_ITS_SERVER, encoding="utf-8")
+    (tmp_path / "app_kills.py").write_text(APP_KILLS_ITS_SERVER.format(box=str(box)), encoding="utf-8")
+    done = subprocess.run([sys.executable, "-c", SERVER_KILLED_CALLERS[what]], cwd=tmp_path, env=env,
+                          capture_output=True, text=True, timeout=300)
+    expected = {"pytest run": str(int(pytest.ExitCode.TESTS_FAILED)), "app": "recorded"}[what]
+    assert done.returncode == 0 and done.stdout.strip().splitlines()[-1:] == [expected], (
+        f"the {what} whose fork server died should be read as {expected}, but the caller exited "
+        f"{done.returncode} printing {done.stdout[-500:]!r}; stderr {done.stderr[-1500:]}")

@@ -14,6 +14,7 @@ the kit's own code (:func:`kit_crash_site`, read from the dump faulthandler writ
 
 from __future__ import annotations
 
+import contextlib
 import json
 import linecache
 import multiprocessing
@@ -25,6 +26,7 @@ import sys
 import sysconfig
 import tempfile
 import threading
+import time
 import types
 from pathlib import Path
 
@@ -133,18 +135,14 @@ def _run_child(argv: list[str], env: dict, timeout: float, stderr_path: Path) ->
         command = [sys.executable, "-m", "conformance.apps.child", *argv]
         done = subprocess.run(command, capture_output=True, text=True, timeout=timeout, env=env, stdin=subprocess.DEVNULL)
         return done.returncode, done.stderr
-    process = context.Process(target=_child_main, args=(argv, env, str(stderr_path), os.getpid()), daemon=False)
+    status_path = stderr_path.with_name("status")
+    process = context.Process(target=_child_main, args=(argv, env, str(stderr_path), os.getpid(), str(status_path)),
+                              daemon=False)
     start(process)
-    try:
-        process.join(timeout)
-        timed_out = process.exitcode is None
-    finally:
-        if process.exitcode is None:  # past the timeout, or interrupted (Ctrl-C): it does not outlive the kit's
-            process.kill()
-            process.join()
-    if timed_out:
+    code = join(process, timeout, status_path)  # past the timeout, or interrupted (Ctrl-C): it does not outlive the kit
+    if code is None:
         raise subprocess.TimeoutExpired(argv, timeout, stderr=read(stderr_path))
-    return process.exitcode, read(stderr_path)
+    return code, read(stderr_path)
 
 
 def start(process) -> None:
@@ -160,6 +158,76 @@ def start(process) -> None:
             sys.modules["__main__"] = main
 
 
+#: What multiprocessing reports as the exit status of a process forked from a server that ended before it
+#: could pass the status on (its pipe read at end of file): not the process's own status.
+SERVER_GONE = 255
+
+
+def join(process, timeout: float | None, status_path: Path) -> int | None:
+    """Wait up to ``timeout`` seconds for ``process``, forked from the server; its exit status, or None when it
+    ran past ``timeout`` or the wait was interrupted (it is killed then: it never outlives the kit).
+
+    The status is the one the server passes on, or, where the server ended first (:data:`SERVER_GONE`, and
+    the process may still be running), the one the process wrote to ``status_path`` with :func:`leave` once
+    it has ended. Seen once in CI: a wrong sync's forked run read 255 though its pytest run had ended with 1
+    and written its report (FURY 2, cause not found); verdicts go by the process's own status."""
+    deadline = None if timeout is None else time.monotonic() + timeout
+    try:
+        process.join(timeout)
+        if process.exitcode is None:
+            return None
+        if process.exitcode != SERVER_GONE:
+            return process.exitcode
+        if not _ended(process.pid, deadline):
+            return None
+        try:
+            return int(status_path.read_text(encoding="utf-8"))
+        except (OSError, ValueError):  # it died before it could say: the server's 255 is all there is
+            return SERVER_GONE
+    finally:
+        if process.exitcode is None:
+            process.kill()
+            process.join()
+        elif process.exitcode == SERVER_GONE and _alive(process.pid):  # past the timeout, or interrupted
+            with contextlib.suppress(OSError):
+                os.kill(process.pid, signal.SIGKILL)
+
+
+def _alive(pid: int) -> bool:
+    """Whether ``pid`` still runs: an orphan that has ended waits as a zombie until whoever took it over (init,
+    which in a container may never) reaps it, so a zombie has ended."""
+    try:
+        with open(f"/proc/{pid}/stat", encoding="ascii", errors="replace") as fh:
+            return fh.read().rpartition(")")[2].split()[0] not in ("Z", "X")
+    except FileNotFoundError:
+        return False
+    except OSError:  # no /proc: a signal of 0 says whether it is there (a zombie counts as running)
+        try:
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            return False
+        except PermissionError:
+            pass
+        return True
+
+
+def _ended(pid: int, deadline: float | None) -> bool:
+    """Wait until ``pid`` (reaped by whoever took it over) has ended, or ``deadline`` passed: whether it ended."""
+    while _alive(pid):
+        if deadline is not None and time.monotonic() > deadline:
+            return False
+        time.sleep(0.05)
+    return True
+
+
+def leave(code, status_path: str) -> None:
+    """In a forked process: write its exit status ``code`` where :func:`join` reads it, and exit with it."""
+    code = 0 if code is None else code if isinstance(code, int) else 1  # as sys.exit reads it
+    with contextlib.suppress(OSError):
+        Path(status_path).write_text(str(code), encoding="utf-8")
+    sys.exit(code)
+
+
 def read(path: Path) -> str:
     """A child's output file as text (empty if it wrote none)."""
     try:
@@ -168,7 +236,7 @@ def read(path: Path) -> str:
         return ""
 
 
-def _child_main(argv: list[str], env: dict, stderr_path: str, caller: int) -> None:
+def _child_main(argv: list[str], env: dict, stderr_path: str, caller: int, status_path: str) -> None:
     """In the forked process: what ``python -m conformance.apps.child ARGV`` would do, with its output
     where :func:`_run_child` reads it (stdout nowhere, as before: only stderr is ever shown)."""
     import atexit
@@ -191,7 +259,7 @@ def _child_main(argv: list[str], env: dict, stderr_path: str, caller: int) -> No
         atexit._run_exitfuncs()  # a process of multiprocessing's ends in os._exit: the app's handlers, the Xvfb it started
         sys.stdout.flush()
         sys.stderr.flush()
-    sys.exit(code)
+    leave(code, status_path)
 
 
 #: The kit's own package: a crash whose innermost frame is here is the kit's.

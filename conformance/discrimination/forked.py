@@ -34,23 +34,17 @@ def run(argv: list[str], *, env: dict[str, str], timeout: float | None = None) -
     if context is None:
         return None
     with tempfile.TemporaryDirectory(prefix="kit-forked-") as tmp:
-        out, err = os.path.join(tmp, "stdout"), os.path.join(tmp, "stderr")
-        process = context.Process(target=_main, args=(list(argv), dict(env), os.getcwd(), out, err, os.getpid()),
+        out, err, status = (os.path.join(tmp, name) for name in ("stdout", "stderr", "status"))
+        process = context.Process(target=_main, args=(list(argv), dict(env), os.getcwd(), out, err, os.getpid(), status),
                                   daemon=False)
         launch.start(process)
-        try:
-            process.join(timeout)
-            timed_out = process.exitcode is None
-        finally:
-            if process.exitcode is None:  # past the timeout, or interrupted: it does not outlive the caller
-                process.kill()
-                process.join()
-        if timed_out:
+        code = launch.join(process, timeout, Path(status))  # past the timeout, or interrupted: it does not outlive the caller
+        if code is None:
             raise subprocess.TimeoutExpired(argv, timeout)
-        return subprocess.CompletedProcess(argv, process.exitcode, launch.read(Path(out)), launch.read(Path(err)))
+        return subprocess.CompletedProcess(argv, code, launch.read(Path(out)), launch.read(Path(err)))
 
 
-def _main(argv: list[str], env: dict[str, str], cwd: str, out: str, err: str, caller: int) -> None:
+def _main(argv: list[str], env: dict[str, str], cwd: str, out: str, err: str, caller: int, status: str) -> None:
     """In the forked process: what ``python -m pytest ARGV`` started in ``cwd`` with ``env`` would do."""
     import atexit
 
@@ -78,4 +72,5 @@ def _main(argv: list[str], env: dict[str, str], cwd: str, out: str, err: str, ca
         atexit._run_exitfuncs()  # a process of multiprocessing's ends in os._exit: the Xvfb the run started, say
         sys.stdout.flush()
         sys.stderr.flush()
+    Path(status).write_text(str(int(code)), encoding="utf-8")  # what the caller goes by if the server ends first
     sys.exit(int(code))
