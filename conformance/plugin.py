@@ -219,7 +219,7 @@ def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line("markers", "sync: a check that runs the sync implementation under test (added automatically)")
     config.addinivalue_line("markers", "draws: a check whose examples are drawn at random (Hypothesis; added automatically "
                             "to a @given check): what `precision` and the kit's random-draw slice run")
-    config.addinivalue_line("markers", "soft: a check of a scene with soft bodies (cloth, soft_ball; added automatically): "
+    config.addinivalue_line("markers", "soft: a check of a scene with soft bodies (cloth, soft_ball, jelly; added automatically): "
                             "-m 'not soft' leaves them out, for a program that has no soft bodies")
     # pytest-xdist registers it itself; without xdist installed the kit's grouping of a scene's checks
     # would otherwise warn as an unknown mark in every run.
@@ -635,15 +635,17 @@ def pytest_deselected(items) -> None:
 
 
 def _why_deselected(item: pytest.Item) -> str:
-    """What left ``item`` out: ``-m EXPR`` when the marker expression does not match it (``-m 'not soft'``,
-    from the command line or the ini's ``addopts``), else ``-k EXPR``, else ``--shard K/N``, else "deselected"."""
+    """What left ``item`` out: ``-k EXPR`` when the keyword expression does not match it (what was asked for
+    names other scenes: the table leaves the scene out unsaid), else ``-m EXPR`` when the marker expression does
+    not (``-m 'not soft'``, from the command line or the ini's ``addopts``), else ``--shard K/N``, else
+    "deselected"."""
     option = item.config.option
     try:  # pytest's own matchers, as its -m and -k use them
         from _pytest.mark import KeywordMatcher, MarkMatcher
         from _pytest.mark.expression import Expression
 
-        for flag, expression, matcher in (("-m", getattr(option, "markexpr", ""), lambda: MarkMatcher.from_markers(item.iter_markers())),
-                                          ("-k", getattr(option, "keyword", ""), lambda: KeywordMatcher.from_item(item))):
+        for flag, expression, matcher in (("-k", getattr(option, "keyword", ""), lambda: KeywordMatcher.from_item(item)),
+                                          ("-m", getattr(option, "markexpr", ""), lambda: MarkMatcher.from_markers(item.iter_markers()))):
             if expression and not Expression.compile(expression).evaluate(matcher()):
                 return f"{flag} {expression!r}"
     except Exception:  # pytest's internals moved, or its parser refused the expression: say less, never fail
@@ -726,9 +728,12 @@ def _scene_rows(config: pytest.Config, stopped: bool) -> list[tuple[str, str, st
         if scene in verdicts or (selected or {}).get(scene) or not any(r.startswith("-m ") for r in reasons):
             continue
         count = sum(reasons.values())
-        why = " and ".join(sorted(reasons, key=lambda r: (not r.startswith("-m "), -reasons[r])))
-        rows.append(("LEFT OUT", scene, f"left out: {why} deselected its {count} checks"
-                     + (" (a scene with soft bodies)" if _has_soft_bodies(scene, {}) else "")))
+        marks = {r: n for r, n in reasons.items() if r.startswith("-m ")}
+        why = " and ".join(sorted(marks, key=lambda r: -marks[r]))
+        rest = count - sum(marks.values())  # also not asked for by -k (or --shard): said, not blamed on -m
+        said = f"{why} deselected its {count} checks" if not rest else \
+            f"{why} deselected {count - rest} of its {count} checks, {' and '.join(r for r in reasons if r not in marks)} the other {rest}"
+        rows.append(("LEFT OUT", scene, f"left out: {said}" + (" (a scene with soft bodies)" if _has_soft_bodies(scene, {}) else "")))
     return rows
 
 

@@ -9,6 +9,7 @@ parameters (no globals, every random draw seeded), own one DIRECT client and alw
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping, Sequence
 
@@ -70,22 +71,37 @@ class Shape:
 
 @dataclass(frozen=True)
 class Surface:
-    """How a soft body is drawn: triangles over its simulated nodes, one vertex per node in pyBullet's
-    node order (``getMeshData(body, -1, flags=MESH_DATA_SIMULATION_MESH)``), flat shaded.
+    """How a soft body is drawn: triangles over its simulated nodes (``getMeshData(body, -1,
+    flags=MESH_DATA_SIMULATION_MESH)``), flat shaded.
 
-    ``faces`` index the nodes, as the OBJ file the body was loaded from does (:meth:`Scene.add_soft_body`
-    checks that pyBullet kept that file's vertices as its nodes, in order)."""
+    ``nodes`` says which node each drawn vertex follows: None for every node in pyBullet's order (a surface
+    body from an OBJ file, whose ``faces`` index the file's vertices, which :meth:`Scene.add_soft_body`
+    checks pyBullet kept as its nodes, in order); for a volumetric body (tetrahedra, from a ``.vtk`` file or
+    a ``<deformable>`` URDF) the nodes on its boundary, whose inside nodes are not drawn. ``faces`` index the
+    drawn vertices."""
 
     faces: tuple[tuple[int, int, int], ...]
     color: tuple[float, float, float] = (0.8, 0.8, 0.8)
-    #: the file's vertices as written, unscaled and unmoved: what pyBullet's visual mesh of the body holds
-    #: until its first step (``getMeshData`` without ``MESH_DATA_SIMULATION_MESH``, one vertex per face corner)
+    #: the file's vertices as written, unscaled and unmoved: what pyBullet's visual mesh of a surface body
+    #: holds until its first step (``getMeshData`` without ``MESH_DATA_SIMULATION_MESH``, one vertex per face corner)
     file_vertices: np.ndarray | None = field(default=None, compare=False, repr=False)
+    #: the node of each drawn vertex (None: vertex k is node k, every node drawn)
+    nodes: tuple[int, ...] | None = None
+    #: a tetrahedral body: pyBullet's visual mesh is its boundary faces' corners at the nodes, from the start
+    volumetric: bool = False
     kind = "surface"
 
     def __post_init__(self):
         if not self.faces or any(len(f) != 3 or min(f) < 0 for f in self.faces):
-            raise InvalidArgument(f"faces={self.faces!r}, but should be triangles of node indices (three integers >= 0 each)")
+            raise InvalidArgument(f"faces={self.faces!r}, but should be triangles of vertex indices (three integers >= 0 each)")
+        if self.nodes is not None and max(max(f) for f in self.faces) >= len(self.nodes):
+            raise InvalidArgument(f"faces index {max(max(f) for f in self.faces) + 1} vertices, but nodes={len(self.nodes)} "
+                                  f"nodes are drawn: give each drawn vertex its node")
+
+    def node_faces(self) -> np.ndarray:
+        """The faces as node indices, ``(n, 3)``: each face's corners as pyBullet's nodes."""
+        faces = np.asarray(self.faces, dtype=np.int64)
+        return faces if self.nodes is None else np.asarray(self.nodes, dtype=np.int64)[faces]
 
 
 def obj_mesh(path: str) -> tuple[np.ndarray, tuple[tuple[int, int, int], ...]]:
@@ -104,6 +120,25 @@ def obj_mesh(path: str) -> tuple[np.ndarray, tuple[tuple[int, int, int], ...]]:
                 corners = [c - 1 if c > 0 else len(vertices) + c for c in corners]
                 faces.extend((corners[0], corners[k], corners[k + 1]) for k in range(1, len(corners) - 1))
     return np.asarray(vertices, dtype=np.float64).reshape(-1, 3), tuple(faces)
+
+
+def vtk_points(path: str) -> np.ndarray:
+    """The points ``(n, 3)`` of a legacy ASCII VTK file (``POINTS n float``, then the coordinates): the nodes a
+    soft body loaded from a tetrahedral ``.vtk`` file has, in order, before scaling and placing."""
+    words = open(path, encoding="ascii").read().split()
+    at = words.index("POINTS")
+    count = int(words[at + 1])
+    return np.asarray(words[at + 3:at + 3 + 3 * count], dtype=np.float64).reshape(count, 3)
+
+
+def deformable_mesh(urdf: str) -> str:
+    """The path of the mesh a ``<deformable>`` URDF names (its ``visual`` filename, beside the URDF)."""
+    import xml.etree.ElementTree as ElementTree
+
+    visual = ElementTree.parse(urdf).getroot().find("deformable/visual")
+    if visual is None or not visual.get("filename"):
+        raise SceneError(f"{urdf}: no <deformable><visual filename=…/> to load")
+    return os.path.join(os.path.dirname(os.path.abspath(urdf)), visual.get("filename"))
 
 
 @dataclass(frozen=True)
@@ -271,12 +306,22 @@ class Scene:
         return body
 
     def add_soft_body(self, name: str, path: str, *, position: Sequence[float], color: tuple[float, float, float],
-                      scale: float = 1.0, anchors: Sequence[int] = (), **soft: Any) -> int:
-        """Load the OBJ mesh at ``path`` as a soft body (``loadSoftBody(path, basePosition=position,
-        scale=scale, **soft)``), pin ``anchors`` (node indices) to the world (``createSoftBodyAnchor``),
-        and bind it for drawing as a :class:`Surface` of the file's triangles. Needs a ``deformable`` scene."""
-        if not self.deformable:
-            raise SceneError(f"scene {self.name!r}: a soft body needs a deformable world (SceneSpec(deformable=True))")
+                      scale: float = 1.0, anchors: Sequence[int] = (), orientation: Sequence[float] = IDENTITY,
+                      **soft: Any) -> int:
+        """Load the mesh at ``path`` as a soft body (``loadSoftBody(path, basePosition=position,
+        baseOrientation=orientation, scale=scale, **soft)``), pin ``anchors`` (node indices) to the world
+        (``createSoftBodyAnchor``), and bind it for drawing as a :class:`Surface`: an OBJ file's triangles
+        through every node, or a tetrahedral ``.vtk`` file's boundary (:meth:`add_deformable`). Needs a
+        ``deformable`` scene."""
+        self._needs_deformable_world(name)
+        if str(path).endswith(".vtk"):
+            body = self.p.loadSoftBody(path, basePosition=list(position), baseOrientation=list(orientation), scale=scale,
+                                       **soft)
+            self._loaded_as_written(name, body, path, position, orientation, scale)
+            return self._bind_volumetric(name, body, path, color, anchors)
+        if tuple(orientation) != IDENTITY:
+            raise InvalidArgument(f"orientation={tuple(orientation)!r} for the OBJ soft body {name!r}, but should be the "
+                                  f"identity: the file's faces are checked against its vertices where they were put")
         body = self.p.loadSoftBody(path, basePosition=list(position), scale=scale, **soft)
         vertices, faces = obj_mesh(path)
         nodes = np.asarray(self.p.getMeshData(body, -1, flags=pybullet.MESH_DATA_SIMULATION_MESH)[1], dtype=np.float64)
@@ -287,6 +332,54 @@ class Scene:
         for node in anchors:
             self.p.createSoftBodyAnchor(body, int(node), -1, -1)
         self.bind(name, body, -1, Surface(faces=faces, color=color, file_vertices=vertices))
+        return body
+
+    def add_deformable(self, name: str, path: str, *, position: Sequence[float], color: tuple[float, float, float],
+                       orientation: Sequence[float] = IDENTITY, anchors: Sequence[int] = ()) -> int:
+        """Load the URDF at ``path``, a ``<deformable>`` body of a tetrahedral mesh (``loadURDF(path,
+        basePosition=position, baseOrientation=orientation)``), and bind it for drawing by its boundary, as
+        :meth:`add_soft_body` does a ``.vtk`` file. Needs a ``deformable`` scene."""
+        self._needs_deformable_world(name)
+        body = self.p.loadURDF(path, basePosition=list(position), baseOrientation=list(orientation))
+        self._loaded_as_written(name, body, deformable_mesh(path), position, orientation, 1.0)
+        return self._bind_volumetric(name, body, path, color, anchors)
+
+    def _needs_deformable_world(self, name: str) -> None:
+        if not self.deformable:
+            raise SceneError(f"scene {self.name!r}: soft body {name!r} needs a deformable world (SceneSpec(deformable=True))")
+
+    def _loaded_as_written(self, name: str, body: int, mesh: str, position, orientation, scale: float) -> None:
+        """Check that the body's nodes are ``mesh``'s points, scaled and placed, in order. pyBullet looks for a
+        URDF's mesh in the working directory before the URDF's own (measured: a ``jelly.vtk`` in the directory
+        the kit ran from was loaded instead of the kit's, and blew up)."""
+        nodes = np.asarray(self.p.getMeshData(body, -1, flags=pybullet.MESH_DATA_SIMULATION_MESH)[1], dtype=np.float64)
+        points = vtk_points(mesh).astype(np.float32).astype(np.float64) * scale  # pyBullet reads them in single precision
+        rotation = np.asarray(pybullet.getMatrixFromQuaternion(list(orientation))).reshape(3, 3)
+        expected = points @ rotation.T + np.asarray(position, dtype=np.float64)
+        if nodes.shape != expected.shape or not np.allclose(nodes, expected, atol=1e-6):
+            raise SceneError(f"scene {self.name!r}: soft body {name!r} has {len(nodes)} nodes that are not the {len(points)} "
+                             f"points of {mesh} in order (placed and scaled): pyBullet loaded another mesh; is there a "
+                             f"file named {os.path.basename(mesh)!r} in the directory you run from ({os.getcwd()})? "
+                             f"pyBullet looks there first")
+
+    def _bind_volumetric(self, name: str, body: int, path: str, color, anchors: Sequence[int]) -> int:
+        """Bind a tetrahedral soft body by its boundary, as pyBullet itself draws it: its visual mesh is the
+        boundary faces' corners, each at a node (measured to the bit, tests/test_soft_bodies.py), so the
+        faces are read from it, and each drawn vertex is a boundary node."""
+        nodes = np.asarray(self.p.getMeshData(body, -1, flags=pybullet.MESH_DATA_SIMULATION_MESH)[1], dtype=np.float64)
+        corners = np.asarray(self.p.getMeshData(body, -1)[1], dtype=np.float64).reshape(-1, 3)
+        found = {tuple(v): k for k, v in enumerate(nodes)}
+        at = [found.get(tuple(v), -1) for v in corners]
+        if not nodes.size or not corners.size or len(corners) % 3 or min(at) < 0 or len(found) != len(nodes):
+            raise SceneError(f"scene {self.name!r}: soft body {name!r} from {path}: pyBullet's visual mesh ({len(corners)} "
+                             f"corners) is not faces through its {len(nodes)} distinct nodes, so the kit cannot say which "
+                             f"node each drawn vertex follows")
+        boundary = np.unique(at)
+        faces = np.searchsorted(boundary, np.asarray(at)).reshape(-1, 3)
+        for node in anchors:
+            self.p.createSoftBodyAnchor(body, int(node), -1, -1)
+        self.bind(name, body, -1, Surface(faces=tuple(map(tuple, faces.tolist())), color=color,
+                                          nodes=tuple(boundary.tolist()), volumetric=True))
         return body
 
     def bind(self, name: str, body: int, link: int, shape: Shape | Surface, *, actor: str | None = None) -> Binding:

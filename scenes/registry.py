@@ -31,6 +31,7 @@ _MODULES = (
     "crossing",
     "cloth",
     "soft_ball",
+    "jelly",
 )
 
 

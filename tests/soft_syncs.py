@@ -2,8 +2,8 @@
 (:class:`conformance.implementations.frames.SoftBodies`) rewritten the way a user gets it wrong. Rigid
 bodies stay right, so the mistake is the only difference.
 
-They live apart from ``wrong_syncs`` because only the soft scenes (``cloth``, ``soft_ball``) can reject
-them; ``tests/test_soft_bodies.py`` runs them there.
+They live apart from ``wrong_syncs`` because only the soft scenes (``cloth``, ``soft_ball``, ``jelly``) can reject
+them (``EveryNode`` only the volumetric ``jelly``); ``tests/test_soft_bodies.py`` runs them there.
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ from conformance.bullet import truth
 from conformance.implementations.frames import SoftBodies
 from conformance.implementations.reference import ReferenceSync
 
-__all__ = ["CopiedOnce", "Float16Nodes", "MovesTheCloth", "NodesReversed", "OneStepLateNodes", "PartlyCopied",
+__all__ = ["CopiedOnce", "EveryNode", "Float16Nodes", "MovesTheCloth", "NodesReversed", "OneStepLateNodes", "PartlyCopied",
            "VisualMesh"]
 
 
@@ -138,3 +138,19 @@ class MovesTheCloth(ReferenceSync):
         for t in self.targets:
             if t.nodes is not None:
                 self.p.resetMeshData(t.body, vertices=(truth.nodes(self.p, t.body) + [0.0, 0.0, 1e-6]).tolist())
+
+
+class _EveryNode(SoftBodies):
+    def vertices(self, t, nodes):
+        return nodes[:len(t.nodes)]  # vertex k at node k: right for a surface, whose every node is drawn
+
+
+class EveryNode(ReferenceSync):
+    """Wrong: draws vertex k at node k, as a sync written for surface soft bodies does, where every node is drawn
+    in order. A volumetric body draws only its boundary nodes (``Target.nodes``), so its vertices land on the
+    first nodes, inside and out: right on ``cloth`` and ``soft_ball``, wrong on ``jelly``.
+
+    Diagnosis: every-node
+    """
+
+    soft_bodies = _EveryNode

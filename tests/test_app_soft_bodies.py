@@ -127,3 +127,39 @@ def test_a_soft_ball_whose_normals_follow_its_shape_passes():
     assert any("162 vertices follow soft-body nodes" in note for note in result.verdicts["normals"].notes)
     pictured = [t["target"] for record, _ in result.verdicts["pictured"].pictures for t in record.details["targets"]]
     assert pictured.count("soft body 1 (ball)") == len(result.verdicts["pictured"].pictures), pictured
+
+
+def test_the_nodes_inside_a_tetrahedral_body_are_not_drawn_by_pybullet():
+    """pyBullet draws a tetrahedral body by its visual mesh, the boundary's triangles with every corner at a node:
+    the 9 nodes inside the kit's jelly block are on none of them (``Frame.shown`` 0) and need not be drawn. A
+    surface from an OBJ file away from the origin, whose visual mesh is the file's vertices unmoved before its
+    first step, cannot be told so: every node is asked for (-1)."""
+    from conformance import scenes
+
+    with scenes.build("jelly") as scene:
+        frames = bodies.frames_of([scene.client])
+        for binding in [b for b in scene.bindings if b.soft]:
+            shown = {f.node: f.shown for f in frames if f.body == binding.body}
+            assert sorted(n for n, s in shown.items() if s == 1) == list(binding.shape.nodes)
+            assert sum(s == 0 for s in shown.values()) == 9 and len(shown) == 75
+    with scenes.build("cloth") as scene:
+        assert {f.shown for f in bodies.frames_of([scene.client]) if f.node >= 0} == {-1}
+
+
+def test_a_soft_body_drawn_as_one_rigid_piece_is_told_from_one_that_deforms():
+    """``drawn-as-rigid``: vertices held by no node that move as one rigid piece (a deformable URDF posed by its
+    base's pose); vertices that squash, or never move, are not."""
+    import numpy as np
+    from scipy.spatial.transform import Rotation
+
+    from conformance.apps import soft_bodies
+
+    rng = np.random.default_rng(0)
+    block = rng.uniform(-0.15, 0.15, (75, 3))
+    turns = Rotation.from_rotvec(np.outer(np.linspace(0, 0.8, 20), [0.3, 1.0, 0.2]))
+    rigid = np.stack([turn.apply(block) + [0.01 * t, 0.0, -0.02 * t] for t, turn in enumerate(turns)])
+    assert soft_bodies._rigid(rigid, 1e-6)
+    squashed = rigid.copy()
+    squashed[..., 2] *= np.linspace(1.0, 0.7, 20)[:, None]  # flattened a little more each tick
+    assert not soft_bodies._rigid(squashed, 1e-6)
+    assert not soft_bodies._rigid(np.repeat(block[None], 20, axis=0), 1e-6)  # never moved: another mistake

@@ -123,7 +123,7 @@ def test_pictures_and_changes_the_renderer_was_not_told_of(capsys):
     (["reference", "reference", "free_fall", "--image", "-2"], "error: --image=-2 (int), but should be a whole number from 0"),
     (["reference", "reference", "--image", "free_fall"], "error: --image='free_fall' (str), but should be a frame number, 0 or "
                                                          "more; 'free_fall' is a scene: name the scenes before --image"),
-    (["reference", "reference", "--params", '{"size": 1}'], "error: --params applies to one scene, but 16 are selected"),
+    (["reference", "reference", "--params", '{"size": 1}'], "error: --params applies to one scene, but 17 are selected"),
     (["reference", "reference", "free_fall", "--params", '{"rows": 1}'], "error: --params names 'rows', but scene "
                                                                          "'free_fall' has no such parameter"),
 ])

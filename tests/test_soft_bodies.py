@@ -1,7 +1,9 @@
-"""Soft bodies in sync mode (the ``cloth`` and ``soft_ball`` scenes): each check that judges them fails on a
+"""Soft bodies in sync mode (the ``cloth`` and ``soft_ball`` surfaces, the volumetric ``jelly``): each check that judges them fails on a
 sync that draws them wrongly, and what the kit reads and restores of them is exact."""
 
 from __future__ import annotations
+
+import os
 
 import numpy as np
 import pytest
@@ -20,7 +22,11 @@ def kit(spec: str) -> Kit:
     return Kit(sync.load(spec), DEFAULT)
 
 
-@pytest.mark.parametrize("scene_name", ["cloth", "soft_ball"])
+#: the soft scenes and the name of the soft body each check fails on first
+SOFT = {"cloth": "cloth", "soft_ball": "ball", "jelly": "jelly(?:_urdf)?"}
+
+
+@pytest.mark.parametrize("scene_name", sorted(SOFT))
 @pytest.mark.parametrize("spec, frame, diagnosis", [
     # wrong from frame 0; the other two from the first frame the body moves, where late and once draw alike:
     # told apart by a run to the next frame (issue 48)
@@ -33,13 +39,60 @@ def kit(spec: str) -> Kit:
     ("soft_syncs:VisualMesh", 0, r"drawn at the soft body's visual mesh \(getMeshData without MESH_DATA_SIMULATION_MESH"),
 ])
 def test_every_frame_check_fails_on_a_wrong_soft_body(spec, frame, diagnosis, scene_name):
-    body = "cloth" if scene_name == "cloth" else "ball"
+    body = SOFT[scene_name]
     with pytest.raises(Failed, match=rf"'{body}' \(body \d\) vertex \d+ is drawn at .* but should be at .*: error .* > tolerance "
-                                     rf".*\[{scene_name}\(.*frame {frame}, .*\ndiagnosis: .*{diagnosis}.*\nreproduce: "):
+                                     rf".*\[{scene_name}\(.*frame {frame}, .*\ndiagnosis: .*{diagnosis}.*\n(?:.*also: .*\n)?reproduce: "):
         checks.test_vertices_match_poses_every_frame(scene_name, kit(spec))
 
 
-@pytest.mark.parametrize("scene_name", ["cloth", "soft_ball"])
+def test_a_volumetric_body_drawn_as_a_surface_is_named_every_node():
+    """A sync written for surface soft bodies draws vertex k at node k; on a tetrahedral body, whose drawn
+    vertices are its boundary nodes, that puts them on the first nodes, some inside."""
+    with pytest.raises(Failed, match=r"'jelly(?:_urdf)?' \(body \d\) vertex \d+ is drawn at .*\[jelly\(.*frame 0, .*\ndiagnosis: "
+                                     r"vertex k is drawn at node k, the first 66 of the body's 75 nodes: this soft body is "
+                                     r"volumetric"):
+        checks.test_vertices_match_poses_every_frame("jelly", kit("soft_syncs:EveryNode"))
+    for surface in ("cloth", "soft_ball"):  # every node drawn in order: the same sync is right there
+        checks.test_vertices_match_poses_every_frame(surface, kit("soft_syncs:EveryNode"))
+
+
+def test_a_volumetric_body_is_drawn_by_its_boundary_as_pybullet_draws_it():
+    """The jelly's blocks, one from ``loadSoftBody(.vtk)`` and one from a ``<deformable>`` URDF: 75 nodes each, 9
+    inside; drawn are the 66 boundary nodes and the 128 faces of pyBullet's own visual mesh, whose corners are
+    those nodes, to the bit, before the first step and after 40."""
+    import pybullet
+
+    from conformance import backends
+
+    with scenes.build("jelly") as scene:
+        drawing = backends.build(scene)
+        soft = [t for t in drawing.targets if t.nodes is not None]
+        assert [t.name for t in soft] == ["jelly", "jelly_urdf"]
+        for steps in (0, 40):
+            scene.run(steps)
+            for t, binding in zip(soft, [b for b in scene.bindings if b.soft]):
+                nodes = truth.nodes(scene.p, t.body)
+                visual = np.asarray(pybullet.getMeshData(t.body, -1, physicsClientId=scene.p.client)[1])
+                assert (len(nodes), len(t.nodes), len(binding.shape.faces)) == (75, 66, 128)
+                assert np.array_equal(nodes[binding.shape.node_faces().reshape(-1)], visual)
+        drawing_now = backends.build(scene)
+        for t in [t for t in drawing_now.targets if t.nodes is not None]:
+            np.testing.assert_allclose(backends.world_vertices(t.actor), truth.nodes(scene.p, t.body)[t.nodes], atol=1e-6)
+
+
+def test_a_deformable_urdfs_mesh_shadowed_by_a_file_where_the_kit_runs_is_refused(tmp_path, monkeypatch):
+    """pyBullet looks for a URDF's mesh in the working directory first: another ``jelly.vtk`` there is loaded in
+    the kit's stead, and the scene says so rather than simulate another body."""
+    mesh = os.path.join(os.path.dirname(scenes.__file__), "meshes", "jelly.vtk")
+    text = open(mesh, encoding="ascii").read().replace("\n-0.150000 ", "\n-0.160000 ")
+    (tmp_path / "jelly.vtk").write_text(text, encoding="ascii")
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SceneError, match=r"soft body 'jelly_urdf' has 75 nodes that are not the 75 points of .*jelly.vtk "
+                                         r"in order .*is there a file named 'jelly.vtk' in the directory you run from"):
+        scenes.build("jelly")
+
+
+@pytest.mark.parametrize("scene_name", sorted(SOFT))
 def test_the_visual_mesh_a_diagnosis_expects_is_pybullets(scene_name):
     """The ``visual-mesh`` diagnosis (a sync that reads ``getMeshData`` without ``MESH_DATA_SIMULATION_MESH``) takes
     pyBullet's visual mesh of a soft body loaded from a mesh file for each face's corners in the file's order,
@@ -81,7 +134,7 @@ def test_a_late_copy_and_a_single_copy_are_told_apart_once_the_body_has_moved(sp
         assert words in diagnosis.diagnose_problems(run)
 
 
-@pytest.mark.parametrize("scene_name", ["cloth", "soft_ball"])
+@pytest.mark.parametrize("scene_name", sorted(SOFT))
 def test_every_frame_check_passes_the_reference_on_soft_bodies(scene_name):
     checks.test_vertices_match_poses_every_frame(scene_name, kit("reference"))
 

@@ -193,6 +193,8 @@ class _Read:
     body: int
     name: str
     nodes: int = 0
+    #: per node, whether pyBullet draws it (:func:`_nodes_shown`)
+    shown: tuple = ()
     visuals: tuple = ()
     links: list = field(default_factory=list)
     refused: list = field(default_factory=list)
@@ -228,12 +230,30 @@ def _nodes(p: BoundClient, body: int, call, read: _Read) -> int:
         return 0
 
 
+def _nodes_shown(p: BoundClient, body: int, count: int, call) -> tuple:
+    """For each of a soft body's ``count`` nodes, whether pyBullet's own renderer draws it: 1 where a corner of
+    the body's visual mesh (``getMeshData`` without ``MESH_DATA_SIMULATION_MESH``) lies on it, 0 where none does
+    (a node inside a tetrahedral body: its visual mesh is the boundary's faces, each corner at a node, measured to
+    the bit); -1 each where that cannot be told (no corner on any node: a surface body from an OBJ file before
+    its first step, whose visual mesh is the file's vertices unmoved; or a read that failed)."""
+    if count <= 0:
+        return ()
+    try:
+        nodes = call(pybullet.getMeshData, body, -1, flags=pybullet.MESH_DATA_SIMULATION_MESH, physicsClientId=p.client)[1]
+        corners = set(map(tuple, call(pybullet.getMeshData, body, -1, physicsClientId=p.client)[1]))
+    except (guarded.Refused, pybullet.error):
+        return (-1,) * count
+    shown = tuple(int(tuple(node) in corners) for node in nodes)
+    return shown if len(shown) == count and any(shown) else (-1,) * count
+
+
 def _read(p: BoundClient, body: int, call) -> _Read:
     """Every read :func:`frames_of` makes of ``body``; those that can crash pyBullet through ``call``."""
     base_name, body_name = (_text(v) for v in p.getBodyInfo(body))
     read = _Read(p.client, body, body_name if body_name and body_name != base_name else base_name)
     read.nodes = _nodes(p, body, call, read)
     if read.nodes:
+        read.shown = _nodes_shown(p, body, read.nodes, call)
         return read
     try:
         read.visuals = call(pybullet.getVisualShapeData, body, physicsClientId=p.client)
@@ -287,8 +307,8 @@ def frames_of(clients, notes: list | None = None) -> list[Frame]:
         if notes is not None:
             notes.extend(_note(read, *refused) for refused in read.refused)
         if read.nodes:
-            frames.extend(Frame(read.client, read.body, -1, read.name, float("nan"), (), node=n)
-                          for n in range(max(read.nodes, 0)))
+            frames.extend(Frame(read.client, read.body, -1, read.name, float("nan"), (), node=n, shown=shown)
+                          for n, shown in zip(range(max(read.nodes, 0)), read.shown or (-1,) * max(read.nodes, 0)))
             continue
         visuals, shown = _visuals(read.visuals), _shown(read.visuals)
         unknown = any(instead == INSTEAD["getVisualShapeData"] for *_, instead in read.refused)

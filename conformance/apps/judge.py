@@ -519,7 +519,7 @@ class _Judgement:
             followed.update(int(f) for f in np.unique(a.frame[a.held]) if f >= 0)
         soft_bodies.drawn(self, verdict, followed)
         for index, frame in enumerate(self.r.frames):
-            if not _shown(frame):
+            if frame.node >= 0 or not _shown(frame):  # a soft body's nodes: judged above, the body at once
                 continue
             if len(self.welds) and self.welds[index] >= 0:
                 # A welded frame is given the vertices on its shape that its weld holds, its neighbours' as well

@@ -39,9 +39,12 @@ class Piece:
 def attached(track, attachment, pieces: dict, verdict) -> None:
     """One ``attached`` line per soft body and mistake for the loose vertices that follow its nodes
     (``pieces``: ``(client, body, name, diagnosis) -> [Piece]``): a cloth drawn one step late is one
-    mistake, not one line per vertex."""
+    mistake, not one line per vertex. Vertices named nothing that move as one rigid piece are a soft body
+    posed as a rigid one (``drawn-as-rigid``)."""
     for (client, body, label, diagnosis), found in pieces.items():
         rows = np.concatenate([piece.rows for piece in found])
+        if not diagnosis and _rigid(track.vertices[1:, rows], max(piece.allowed for piece in found)):
+            diagnosis = "drawn-as-rigid"
         first = min(found, key=lambda piece: piece.first_tick)
         worst = max(found, key=lambda piece: piece.worst_error)
         verdict.lines.append(
@@ -50,6 +53,26 @@ def attached(track, attachment, pieces: dict, verdict) -> None:
             f"{first.first_tick + 1}: {first.first_error:.3g} m from that node (allowed "
             f"{max(piece.allowed for piece in found):.3g} m); worst {worst.worst_error:.3g} m at tick {worst.worst_tick + 1}")
         verdict.diagnosed(diagnosis)
+
+
+def _rigid(vertices: np.ndarray, allowance: float) -> bool:
+    """Whether ``vertices`` (ticks, n, 3) move as one rigid piece that does move: at every tick a turn and a shift
+    of the first tick's within ``allowance``, and further than that from where they began. Vertices held by no
+    node move so only when a soft body is drawn as a rigid one (were the body itself rigid here, its nodes
+    would hold them)."""
+    if len(vertices) < 3 or vertices.shape[1] < 4:
+        return False
+    from scipy.spatial.transform import Rotation
+
+    first = vertices[0] - vertices[0].mean(axis=0)
+    moved = False
+    for now in vertices[1:]:
+        centre = now.mean(axis=0)
+        turn, _ = Rotation.align_vectors(now - centre, first)
+        if np.max(np.linalg.norm(turn.apply(first) + centre - now, axis=1)) > allowance:
+            return False
+        moved = moved or np.max(np.linalg.norm(now - vertices[0], axis=1)) > 10 * allowance
+    return moved
 
 
 def _nodes_by_body(frames) -> dict[tuple[int, int], list[int]]:
@@ -62,10 +85,14 @@ def _nodes_by_body(frames) -> dict[tuple[int, int], list[int]]:
 
 
 def drawn(judgement, verdict, followed: set) -> None:
-    """A soft body is drawn when every node of it that moves is followed by some drawn vertex: a program
-    that copies all but the last nodes, or none, leaves nodes moving with nothing drawn on them."""
+    """A soft body is drawn when every node of it that moves and that pyBullet draws is followed by some drawn
+    vertex: a program that copies all but the last nodes, or none, leaves nodes moving with nothing drawn on
+    them. A node pyBullet does not draw (inside a tetrahedral body: ``Frame.shown`` 0) need not be drawn."""
     r = judgement.r
     for (client, body), nodes in _nodes_by_body(r.frames).items():
+        nodes = [i for i in nodes if r.frames[i].shown != 0]
+        if not nodes:
+            continue
         allowance = 10 * judgement.tolerance.for_extents(np.zeros(len(nodes)), judgement.pos[0, nodes])
         moved = np.array([judgement._movement(i, 0.0) for i in nodes])
         missing = [i for i, m, a in zip(nodes, moved, allowance) if m > a and i not in followed]

@@ -66,6 +66,11 @@ DIAGNOSES = {name: text for name, (text, _) in attach_mod.VARIANTS.items() if na
                   "built for another order of the vertices than the one the nodes are copied in (np.unique sorts what it "
                   "returns; mesh libraries merge or reorder vertices): build the faces for the node order of "
                   "getMeshData(body, -1, flags=p.MESH_DATA_SIMULATION_MESH) and copy the nodes in that same order",
+    "drawn-as-rigid": "every vertex that follows this soft body moves as one rigid piece, turned and moved as a whole, "
+                      "while pyBullet's nodes squash and bend: the body is posed as a rigid one (by "
+                      "getBasePositionAndOrientation, as a deformable URDF from loadURDF looks like a robot, or by a "
+                      "matrix on its actor): copy its nodes, getMeshData(body, -1, flags=p.MESH_DATA_SIMULATION_MESH), "
+                      "into the vertices after each step",
     "stale-gpu": "the GPU still holds older vertices of this body: the vertices were written but the range announced "
                  "with positions.update_range(offset, count) does not cover them (offset and count are in vertices); "
                  "announce every range written, or update_full()",
@@ -80,7 +85,7 @@ DIAGNOSES = {name: text for name, (text, _) in attach_mod.VARIANTS.items() if na
 #: Measured on the zoo's injected mistakes (``python -m conformance confusion``, docs/confusion.md).
 LEAD_ORDER = ("before-own-move", "late-or-own-move", "skipped", "previous-step", "wxyz", "scalar-first", "euler-order", "radians-as-degrees",
               "float32-angle-axis", "conjugate", "translation-only", "written-back", "unannounced", "stale-gpu",
-              "node-order", "face-order", "stale-normals", "hidden", "scaled", "mesh-scale", "com-frame", "visual-frame",
+              "node-order", "face-order", "drawn-as-rigid", "stale-normals", "hidden", "scaled", "mesh-scale", "com-frame", "visual-frame",
               "offset-sign", "turned-shape", "never-moved", "other-body", "not-its-shape")
 
 

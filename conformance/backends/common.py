@@ -117,15 +117,18 @@ def lay_out(scene, make_actor: Callable[[str, np.ndarray, np.ndarray, np.ndarray
 
 
 def _soft_actor(scene, binding, make_surface, announce) -> tuple[Any, Target, np.ndarray]:
-    """The actor, target and world geometry of one soft body: a surface through its nodes as they are now."""
+    """The actor, target and world geometry of one soft body: a surface through its drawn nodes as they are now
+    (every node of a surface body; a volumetric body's boundary nodes)."""
+    shape = binding.shape
     nodes = truth.nodes(scene.p, binding.body)
-    faces = np.asarray(binding.shape.faces, dtype=np.int64)
-    # a copy: FURY may keep the array it is given as the actor's vertices, which the sync then rewrites
-    actor = make_surface(nodes.copy(), faces, np.tile(np.asarray(binding.shape.color, dtype=np.float64), (len(nodes), 1)))
+    drawn = np.arange(len(nodes)) if shape.nodes is None else np.asarray(shape.nodes, dtype=np.int64)
+    faces = np.asarray(shape.faces, dtype=np.int64)
+    # fancy indexing copies: FURY may keep the array it is given as the actor's vertices, which the sync rewrites
+    actor = make_surface(nodes[drawn], faces, np.tile(np.asarray(shape.color, dtype=np.float64), (len(drawn), 1)))
     announce(actor)
-    target = Target(name=binding.name, body=binding.body, link=-1, actor=actor, start=0, stop=len(nodes), shared=False,
-                    position=IDENTITY_POSITION.copy(), orientation=IDENTITY_ORIENTATION.copy(), nodes=np.arange(len(nodes)))
-    return actor, target, nodes
+    target = Target(name=binding.name, body=binding.body, link=-1, actor=actor, start=0, stop=len(drawn), shared=False,
+                    position=IDENTITY_POSITION.copy(), orientation=IDENTITY_ORIENTATION.copy(), nodes=drawn)
+    return actor, target, nodes[drawn]
 
 
 @contextlib.contextmanager

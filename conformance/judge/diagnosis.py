@@ -71,6 +71,9 @@ SOFT_WORDS = {
                "metres): keep the vertices in float32 or float64; " + _COPY,
     "visual-mesh": "drawn at the soft body's visual mesh (getMeshData without MESH_DATA_SIMULATION_MESH: one vertex "
                    "per corner of each face, {corners} of them, not the {count} nodes in order): " + _COPY,
+    "every-node": "vertex k is drawn at node k, the first {drawn} of the body's {count} nodes: this soft body is "
+                  "volumetric (tetrahedra) and only its {drawn} boundary nodes are drawn, vertex k at node "
+                  "Target.nodes[k]; the nodes inside are never drawn: " + _COPY,
     # A sync written before soft bodies, which hands every target to its pose code: kept under the
     # JUnit message's share of a diagnosis (conformance.reports.junit), so that -m "not soft" stays in it.
     "drawn-as-rigid": "{name} is a soft body (Target.nodes is not None) and the sync {how}: its vertices must follow "
@@ -295,6 +298,12 @@ def _explain_soft(run, drawn: Drawn, tolerance: float) -> tuple[str, str] | None
             continue
         if np.max(np.linalg.norm(expected - drawn.vertices, axis=1)) <= allowance:
             return "drawn-as-rigid", _as_rigid(t, "posed")
+    if len(now) > len(t.nodes) and not np.array_equal(t.nodes, np.arange(len(t.nodes))):
+        # a volumetric body drawn as if every node were drawn, in order (a sync written for surfaces)
+        expected = now[:len(t.nodes)]
+        if np.max(np.linalg.norm(expected - truth_vertices, axis=1)) > DISTINCT * allowance and \
+                np.max(np.linalg.norm(expected - drawn.vertices, axis=1)) <= allowance:
+            return "every-node", "diagnosis: " + SOFT_WORDS["every-node"].format(drawn=len(t.nodes), count=len(now))
     visual = _visual_mesh(run, i, now, drawn.frame)
     if visual is not None and len(visual) > int(np.max(t.nodes, initial=0)):
         expected = visual[t.nodes]  # the visual mesh indexed as the nodes are (or its first vertices: the same)
@@ -313,15 +322,15 @@ def _visual_mesh(run, index: int, nodes: np.ndarray, frame: int) -> np.ndarray |
     """What ``getMeshData(body)`` without ``MESH_DATA_SIMULATION_MESH`` gives at ``frame`` for the soft body of
     target ``index`` with ``nodes`` now: for a body loaded from a mesh file, each face's corners in the file's
     order (``nodes[faces]``), and before the first step the file's vertices as read, unscaled and unmoved
-    (both equal to pyBullet's to the bit on ``soft_ball`` and ``cloth``, tests/test_soft_bodies.py). None when
-    the scene does not say the faces."""
+    (both equal to pyBullet's to the bit on ``soft_ball`` and ``cloth``, tests/test_soft_bodies.py); for a
+    volumetric body, its boundary faces' corners at the nodes from the start. None when the scene does not say
+    the faces."""
     bindings = getattr(getattr(run, "scene", None), "bindings", None)
     shape = getattr(bindings[index], "shape", None) if bindings and index < len(bindings) else None
-    faces = getattr(shape, "faces", None)
-    if not faces:
+    if not getattr(shape, "faces", None):
         return None
-    corners = np.asarray(faces, dtype=np.int64).reshape(-1)
-    if frame == 0:
+    corners = shape.node_faces().reshape(-1)
+    if frame == 0 and not shape.volumetric:
         written = getattr(shape, "file_vertices", None)
         # pyBullet reads the file in single precision
         return None if written is None else np.asarray(written, dtype=np.float32).astype(np.float64)[corners]
