@@ -17,3 +17,15 @@ class KeepsApart(ReferenceSync):
         a, b = names.index("a"), names.index("b")
         positions[b] = np.maximum(positions[b], positions[a] + (1.2, -np.inf, -np.inf))
         return positions, matrices
+
+
+class LeavesAForce(ReferenceSync):
+    """Wrong: draws right, then pushes every dynamic body up with ``applyExternalForce`` ("to make up for the
+    frame the picture lags"): nothing pyBullet reports changes until the next step, which the force moves."""
+
+    def __call__(self):
+        super().__call__()
+        for t in self.targets:
+            if t.link == -1 and self.p.getDynamicsInfo(t.body, -1)[0] > 0:
+                pos, _ = self.p.getBasePositionAndOrientation(t.body)
+                self.p.applyExternalForce(t.body, -1, [0.0, 0.0, 0.5], pos, 1)  # 1: pybullet.WORLD_FRAME

@@ -9,6 +9,7 @@ them (``EveryNode`` only the volumetric ``jelly``); ``tests/test_soft_bodies.py`
 from __future__ import annotations
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 import pybullet
 
@@ -16,8 +17,8 @@ from conformance.bullet import truth
 from conformance.implementations.frames import SoftBodies
 from conformance.implementations.reference import ReferenceSync
 
-__all__ = ["CopiedOnce", "EveryNode", "Float16Nodes", "MovesTheCloth", "NodesReversed", "OneStepLateNodes", "PartlyCopied",
-           "VisualMesh"]
+__all__ = ["CopiedOnce", "EveryNode", "Float16Nodes", "LoadFrameNodes", "MovesTheCloth", "NodesReversed", "OneStepLateNodes",
+           "PartlyCopied", "StillsTheNodes", "VisualMesh"]
 
 
 class _LateNodes(SoftBodies):
@@ -154,3 +155,43 @@ class EveryNode(ReferenceSync):
     """
 
     soft_bodies = _EveryNode
+
+
+class _LoadFrame(SoftBodies):
+    def vertices(self, t, nodes):
+        # the nodes kept in the body's frame as first read, then posed by the body's pose now, as a rigid
+        # body's vertices are: right while nothing turns the soft body's frame
+        centre, orientation = pybullet.getBasePositionAndOrientation(t.body, physicsClientId=self.client)
+        now = Rotation.from_quat(orientation)
+        first = getattr(self, "first", {})
+        self.first = {**first, t.body: first.get(t.body, now)}
+        local = self.first[t.body].inv().apply(nodes[t.nodes] - centre)
+        return now.apply(local) + centre
+
+
+class LoadFrameNodes(ReferenceSync):
+    """Wrong: keeps each soft body's nodes in the body's frame as it was loaded and poses them by the body's
+    pose now (``getBasePositionAndOrientation``), as it would a rigid body's vertices: exact while the body's
+    frame does not turn. pyBullet turns it itself once the cloth catches the box (frame 96) and once the jelly
+    lands (frame 48); the soft ball's never turns in its own story, so there only the kit's events reveal it:
+    a teleport turns every node (``resetBasePositionAndOrientation``), and the ball is drawn turned twice.
+
+    Diagnosis: -
+    """
+
+    soft_bodies = _LoadFrame
+
+
+class StillsTheNodes(ReferenceSync):
+    """Wrong: draws right, then sets every soft body's node velocities to zero (``resetBaseVelocity``) "so the cloth
+    does not jitter in the picture": the nodes stay where they are, so nothing a sync could read back changed,
+    but the next step starts from rest. A sync must only read.
+
+    Diagnosis: -
+    """
+
+    def __call__(self):
+        super().__call__()
+        for t in self.targets:
+            if t.nodes is not None:
+                self.p.resetBaseVelocity(t.body, [0.0, 0.0, 0.0], [0.0, 0.0, 0.0])

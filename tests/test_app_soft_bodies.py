@@ -118,13 +118,15 @@ def test_a_cloth_whose_triangles_join_other_nodes_is_not_pictured(tmp_path):
 @pytest.mark.full("whole app runs in processes of their own; CI judges app mode end to end on every example app (test_examples)")
 def test_a_soft_ball_whose_normals_follow_its_shape_passes():
     """A right program recomputes a deforming surface's normals every tick; a node has no turn for them to
-    follow, so ``normals`` leaves them out with a note instead of rejecting the right ball with
-    ``stale-normals`` (which it did once the ball landed and squashed, at tick 95). The ball is judged in the
+    follow, so ``normals`` judges them against the surface drawn instead of rejecting the right ball with
+    ``stale-normals`` (which it did once the ball landed and squashed, at tick 95); the same ball with its
+    normals computed once is ``examples/*/wrong/soft_ball_normals_once.py``. The ball is judged in the
     pictures as one surface."""
     ball = CLOTH.parent / "soft_ball.py"
     result = apps.check_app(ball, ticks=120)
     assert result.passed, {k: v.message() for k, v in result.verdicts.items() if not v.passed}
-    assert any("162 vertices follow soft-body nodes" in note for note in result.verdicts["normals"].notes)
+    assert any("162 vertices follow soft-body nodes: their normals are those of the surface drawn" in note
+               for note in result.verdicts["normals"].notes), result.verdicts["normals"].notes
     pictured = [t["target"] for record, _ in result.verdicts["pictured"].pictures for t in record.details["targets"]]
     assert pictured.count("soft body 1 (ball)") == len(result.verdicts["pictured"].pictures), pictured
 

@@ -139,9 +139,66 @@ def test_every_frame_check_passes_the_reference_on_soft_bodies(scene_name):
     checks.test_vertices_match_poses_every_frame(scene_name, kit("reference"))
 
 
+def test_the_kits_soft_events_teleport_turn_and_kick_every_node_at_once():
+    """``SoftTeleport`` moves a soft body's nodes as one rigid piece (the centroid by the offset, never down; the
+    shape kept), ``SoftKick`` sets every node's velocity, and both round-trip through a failure's JSON."""
+    from scipy.spatial.transform import Rotation
+
+    from conformance.bullet import events
+
+    turn = (0.0, 0.0, 0.7071067811865476, 0.7071067811865476)
+    with scenes.build("soft_ball") as scene:
+        ball = next(b.body for b in scene.bindings if b.soft)
+        before = truth.nodes(scene.p, ball)
+        events.SoftTeleport(0, 0, (0.1, 0.0, -0.2), turn).apply(scene)
+        after = truth.nodes(scene.p, ball)
+        np.testing.assert_allclose(after.mean(axis=0) - before.mean(axis=0), (0.1, 0.0, 0.2), atol=1e-9)
+        found, rssd = Rotation.align_vectors(after - after.mean(axis=0), before - before.mean(axis=0))
+        assert rssd < 1e-9 and abs(found.magnitude() - np.pi / 2) < 1e-9  # turned a quarter turn, shape kept
+        events.SoftKick(0, 0, (0.0, 0.0, 2.4)).apply(scene)
+        scene.p.setGravity(0, 0, 0)
+        scene.p.stepSimulation()
+        np.testing.assert_allclose(truth.nodes(scene.p, ball) - after, np.tile((0.0, 0.0, 2.4 * scene.dt), (len(after), 1)),
+                                   atol=1e-9)
+    both = [events.SoftTeleport(3, 1, (0.1, 0.2, 0.3), turn), events.SoftKick(4, 0, (1.0, 2.0, 3.0))]
+    assert events.loads(events.dumps(both)) == both
+    with scenes.build("free_fall") as rigid:  # no soft body: nothing happens
+        state_before = rigid.physics_state()
+        for event in both:
+            event.apply(rigid)
+        assert rigid.physics_state() == state_before
+
+
+def test_a_soft_body_drawn_in_the_frame_it_was_loaded_in_fails_once_a_teleport_turns_it():
+    """``LoadFrameNodes`` poses the soft ball's nodes as a rigid body's vertices, by the body's pose: exact in the
+    ball's own story, where pyBullet never turns its frame; the orientation check's turns show it (a turn of a
+    soft body turns every node), and no diagnosis is named: the mistake is not in the catalogue."""
+    from conformance.checks.strategies import HARD_ORIENTATIONS
+
+    checks.test_vertices_match_poses_every_frame("soft_ball", kit("soft_syncs:LoadFrameNodes"))
+    turns = checks.turned_everything("soft_ball", {}, list(HARD_ORIENTATIONS))
+    assert any(type(e).__name__ == "SoftTeleport" for e in turns)
+    with pytest.raises(Failed, match=r"'ball' \(body \d\) vertex \d+ is drawn at .*\[soft_ball\(.*frame [01], .*events .*soft_teleport"
+                                     r".*\nreproduce: "):
+        checks.check_run(kit("soft_syncs:LoadFrameNodes"), "soft_ball", {}, 2, turns)
+    checks.check_run(kit("reference"), "soft_ball", {}, 2, turns)
+
+
 def test_physics_check_fails_when_the_sync_moves_a_soft_body():
     with pytest.raises(Failed, match=r"the sync changed pybullet's state: .*\[cloth, frame 1"):
         checks.test_sync_does_not_touch_physics("cloth", kit("soft_syncs:MovesTheCloth"))
+
+
+@pytest.mark.parametrize("scene_name", sorted(SOFT))
+def test_physics_check_fails_when_the_sync_sets_the_node_velocities(scene_name):
+    """pyBullet reports no node velocity, so a sync that sets them leaves every readable state as it was; the
+    step after it does not, and the twin stepped without the sync shows it (``conformance.checks.twin``)."""
+    # at frame 0 every node is at rest, so the first sync that changes a velocity is frame 1's
+    with pytest.raises(Failed, match=rf"the step carried it on: after the step of frame 2 it differs from the same scene's "
+                                     rf"stepped without the sync: .*\[{scene_name}, frame 2, .*The sync of frame 1 wrote to "
+                                     rf"pybullet.*node velocities \(resetBaseVelocity\)"):
+        checks.test_sync_does_not_touch_physics(scene_name, kit("soft_syncs:StillsTheNodes"))
+    checks.test_sync_does_not_touch_physics(scene_name, kit("reference"))
 
 
 def test_a_soft_body_is_captured_and_restored_bit_for_bit():

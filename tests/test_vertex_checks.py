@@ -73,6 +73,34 @@ def test_physics_check_fails_when_the_sync_writes_poses_back():
         checks.test_sync_does_not_touch_physics("free_fall", kit("wrong_syncs:WritesPoseBack"))
 
 
+def test_physics_check_fails_when_the_sync_leaves_a_force_pending():
+    """A force applied in the sync changes nothing pyBullet reports until the next step: the same scene stepped
+    without the sync (``conformance.checks.twin``) shows it there."""
+    with pytest.raises(Failed, match=r"the step carried it on: after the step of frame 1 it differs from the same scene's "
+                                     r"stepped without the sync: .*\[free_fall, frame 1, .*The sync of frame 0 wrote to "
+                                     r"pybullet.*applyExternalForce"):
+        checks.test_sync_does_not_touch_physics("free_fall", kit("physics_syncs:LeavesAForce"))
+
+
+def test_a_scene_two_builds_do_not_make_alike_has_no_twin_to_judge_a_sync_by(monkeypatch):
+    """A user's scene that draws unseeded random numbers is not the same when built again: its twin would blame
+    the sync for the scene's own randomness, so it is not used (the determinism check names such a scene)."""
+    import itertools
+
+    from conformance import scenes
+    from conformance.checks import twin
+
+    with scenes.build("free_fall") as scene:
+        alike = twin.Twin(scene)
+        alike.close()
+        heights = itertools.count(3.0, 0.5)  # each build drops the box from another height
+        real = scenes.build
+        monkeypatch.setattr(twin.scenes, "build", lambda name, **params: real(name, **{**params, "height": next(heights)}))
+        unlike = twin.Twin(scene)
+        unlike.close()
+    assert alike.usable and not unlike.usable
+
+
 def test_mesh_check_fails_when_the_sync_recolours():
     with pytest.raises(Failed, match=r"actor 'bricks': colours changed, but a sync should only move vertices"):
         checks.test_sync_keeps_the_mesh("brick_wall_single", kit("wrong_syncs:TintsMovingBodies"))

@@ -25,7 +25,7 @@ import functools
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from conformance.apps import attachment as attach_mod, soft_bodies, welds
+from conformance.apps import attachment as attach_mod, soft_bodies, surface_normals, welds
 from conformance.apps.verdict import DIAGNOSES, Verdict
 from conformance.apps.placement import bounding_radius, bounding_sphere, candidates, place, shape_distance
 from conformance.apps.recording import Recording, vertex_ranges
@@ -708,9 +708,10 @@ class _Judgement:
         verdict = Verdict("normals", True)
         worst = 0.0
         # A soft body's node has a position and no turn: the normals of a surface that follows nodes turn
-        # with its shape, which a right program recomputes every tick; they are not a frame's to judge.
+        # with its shape, which a right program recomputes every tick; they are judged against that shape.
         soft = np.array([f.node >= 0 for f in self.r.frames] + [False])  # the last entry: the world (-1)
-        for track, a, bad in zip(self.r.actors, self.attachments, self.unfinite):
+        offsets = np.concatenate([[0], np.cumsum([len(t.vertices[0]) for t in self.r.actors])]).astype(int).tolist()
+        for index, (track, a, bad) in enumerate(zip(self.r.actors, self.attachments, self.unfinite)):
             if track.normals is None:
                 continue
             if track.radii is not None:  # a shader lights impostor spheres as spheres: no stored normal is used
@@ -727,8 +728,7 @@ class _Judgement:
             on_nodes = soft[frames] & a.held
             judged = a.held & ~on_nodes & ~bad & np.isfinite(angle).all(axis=0)
             if on_nodes.any():
-                verdict.notes.append(f"{track.label}: {int(on_nodes.sum())} vertices follow soft-body nodes, whose normals "
-                                     "turn with the surface's shape, not with a frame: not judged")
+                worst = max(worst, self._surface_normals(verdict, index, track, a, on_nodes & ~bad, offsets))
             worst = max(worst, float(angle[:, judged].max(initial=0)) / self.tolerance.normal_angle)
             bad = np.any(angle > self.tolerance.normal_angle, axis=0) & judged
             for start, stop in _runs(bad, frames):
@@ -740,6 +740,41 @@ class _Judgement:
                 verdict.diagnosed("stale-normals")
         verdict.worst = worst
         return verdict
+
+    def _surface_normals(self, verdict: Verdict, index: int, track, a, on_nodes: np.ndarray, offsets: list) -> float:
+        """Judge the stored normals of ``track``'s vertices that follow soft-body nodes (``on_nodes``) against the
+        drawn surface (:mod:`conformance.apps.surface_normals`); the worst, in units of its angle."""
+        faces = surface_normals.triangles(self.r.pictures, offsets, index, len(on_nodes))
+        if faces is None or not len(faces):
+            verdict.notes.append(f"{track.label}: {int(on_nodes.sum())} vertices follow soft-body nodes, whose normals turn "
+                                 "with the surface's shape: not judged (no picture kept the faces that shape is made of)")
+            return 0.0
+        # vertices on one node are one point of the surface (a mesh drawn with its corners unshared)
+        points = np.where(on_nodes, a.frame, -2 - np.arange(len(on_nodes)))
+        # a few ticks at a time: a cloth of 10,000 nodes has 20,000 faces a tick to turn into normals
+        chunk = max(1, 2_000_000 // max(len(faces), 1))
+        off = np.concatenate([surface_normals.beyond(track.vertices[1 + t:1 + t + chunk], track.normals[1 + t:1 + t + chunk],
+                                                     faces, points) for t in range(0, self.r.ticks, chunk)])
+        off = np.where(on_nodes & np.isfinite(off).all(axis=0), off, -np.inf)
+        outside = off > surface_normals.ANGLE
+        if outside.any():
+            verdict.passed = False
+            ticks, vertices = np.nonzero(outside)
+            tick, vertex = np.unravel_index(int(np.argmax(off)), off.shape)
+            frames = sorted({self.r.frames[f].label.replace(f" node {self.r.frames[f].node}", "")
+                             for f in a.frame[np.unique(vertices)].tolist()})
+            verdict.lines.append(
+                f"{track.label} normals: {len(np.unique(vertices))} of {int(on_nodes.sum())} vertices that follow "
+                f"{', '.join(frames)} are not the normals of the surface drawn, from tick {int(ticks.min()) + 1} on "
+                f"{len(np.unique(ticks))} of {off.shape[0]} ticks; the most, vertex {vertex} at tick {tick + 1}: "
+                f"{np.degrees(off[tick, vertex]):.3g}° outside the faces that meet there (allowed "
+                f"{np.degrees(surface_normals.ANGLE):.3g}°)")
+            verdict.diagnosed("surface-normals")
+        else:
+            verdict.notes.append(f"{track.label}: {int(on_nodes.sum())} vertices follow soft-body nodes: their normals are "
+                                 f"those of the surface drawn (at most {np.degrees(max(float(off.max(initial=0.0)), 0.0)):.2g}° "
+                                 f"outside the faces that meet there; allowed {np.degrees(surface_normals.ANGLE):.3g}°)")
+        return float(np.max(off, initial=0.0)) / surface_normals.ANGLE
 
     def announced(self) -> Verdict:
         verdict = Verdict("announced", True)

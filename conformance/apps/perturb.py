@@ -3,8 +3,8 @@
 An app's bodies move only as its story goes: a wall that tips about one axis never shows that Euler
 angles applied in the wrong order turn a body about the wrong axes. Because the kit drives the app's
 loop, it can do to the app what it does to its scenes (:mod:`conformance.bullet.events`): before the app's
-callback of tick ``k``, turn a body to a hard orientation, kick it, or reset a joint, so that the app's
-sync has to draw poses its story never produces. Every event is applied on every pyBullet client of the
+callback of tick ``k``, turn a body to a hard orientation, kick it, or reset a joint, or teleport or kick a
+soft body (every node at once), so that the app's sync has to draw poses its story never produces. Every event is applied on every pyBullet client of the
 app that has bodies (an app may keep an empty client, or one per world). Events name bodies by position
 in the list of a client's *dynamic* bodies (``which`` modulo its length; static bodies are left where the app put them,
 so an app may draw them as part of the world) and joints by position in the list of movable joints,
@@ -44,8 +44,10 @@ def _scene(client: int, frames: list[Frame], dynamic: bool):
 
     p = BoundClient(client)
     wanted = sorted({f.body for f in frames if f.client == client and f.link == -1 and f.node < 0 and (f.mass > 0 or not dynamic)})
+    soft = sorted({f.body for f in frames if f.client == client and f.node >= 0})
     dt = p.getPhysicsEngineParameters()["fixedTimeStep"]
-    return SimpleNamespace(p=p, bindings=[SimpleNamespace(body=b, soft=False) for b in wanted], dt=dt)
+    return SimpleNamespace(p=p, bindings=[SimpleNamespace(body=b, soft=False) for b in wanted]
+                           + [SimpleNamespace(body=b, soft=True) for b in soft], dt=dt)
 
 
 def apply(events, tick: int, frames: list[Frame]) -> None:
@@ -67,7 +69,7 @@ def _apply(due, client: int, frames: list[Frame]) -> None:
         scene = _scene(client, frames, dynamic=not isinstance(event, scene_events.JointReset))
         if scene.bindings:
             event.apply(scene)
-            if not isinstance(event, scene_events.Kick):
+            if not isinstance(event, (scene_events.Kick, scene_events.SoftKick)):
                 _clear_of_static(scene.p, client, frames)
 
 

@@ -1,8 +1,8 @@
 """Property-based runs of an app: the kit's events between ticks, drawn by Hypothesis.
 
 The first run is always the same hard opening (:func:`opening`): four dynamic bodies turned in place
-to hard orientations (a half turn about a skew axis, Euler gimbal lock, negative w), a joint reset and
-a kick — so that even one perturbed run turns bodies. (Hypothesis's first derandomised draw is the
+to hard orientations (a half turn about a skew axis, Euler gimbal lock, negative w), a joint reset,
+a kick, and a soft body teleported, turned and kicked — so that even one perturbed run turns bodies. (Hypothesis's first derandomised draw is the
 simplest one, no event at all.) The others are drawn by Hypothesis.
 
 Each example is a whole run of the app in its own process (a few seconds), so the search is bounded:
@@ -21,10 +21,11 @@ __all__ = ["opening", "search"]
 
 
 def opening() -> list:
-    """The first perturbed run's events: every way of turning a body the kit has, early in the run, and
-    one body turned between the step and the sync of tick 4, so that the sync sees it at rest."""
+    """The first perturbed run's events: every way of turning a body the kit has, early in the run,
+    one body turned between the step and the sync of tick 4, so that the sync sees it at rest, and a soft
+    body teleported, turned and kicked (no-ops in an app without one)."""
     from conformance.apps.perturb import AfterStep
-    from conformance.bullet.events import JointReset, Kick, Teleport
+    from conformance.bullet.events import JointReset, Kick, SoftKick, SoftTeleport, Teleport
 
     hard = strategies.HARD_ORIENTATIONS
     # a half turn about (1, 1, 1); then, written with negative w, pitch +90°, pitch near -90°, pitch -90°
@@ -32,7 +33,10 @@ def opening() -> list:
     return ([Teleport(frame=1, which=i, offset=(0.0, 0.0, 0.0), orientation=q) for i, q in enumerate(turns)]
             + [JointReset(frame=2, which=0, value=1.0, orientation=hard[10]),
                Kick(frame=3, which=1, velocity=(1.0, -1.0, 2.0), offset=(0.0, 0.0, 0.0), spin=(5.0, -7.0, 3.0)),
-               AfterStep(Teleport(frame=4, which=0, offset=(0.0, 0.0, 0.0), orientation=hard[13]))])
+               AfterStep(Teleport(frame=4, which=0, offset=(0.0, 0.0, 0.0), orientation=hard[13])),
+               # a soft body lifted 0.1 m and turned a half turn about (1, 1, 1), then every node kicked
+               SoftTeleport(frame=5, which=0, offset=(0.0, 0.0, 0.1), orientation=hard[8]),
+               SoftKick(frame=7, which=0, velocity=(1.0, -1.0, 2.0))])
 
 
 class _Found(Exception):

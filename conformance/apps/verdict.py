@@ -42,6 +42,10 @@ DIAGNOSES = {name: text for name, (text, _) in attach_mod.VARIANTS.items() if na
                         "resetBasePositionAndOrientation), and no run could tell which: draw at the end of the tick, "
                         "after the step and the app's own moves",
     "stale-normals": "the vertices turn but the stored normals do not: turn normals with the same rotation",
+    "surface-normals": "the soft body's surface deforms but its stored normals were made for another shape (computed "
+                       "once, when the actor was built): recompute them from the drawn vertices and faces after each "
+                       "copy of the nodes (utils.normals_from_v_f, then utils.normals_to_actor on FURY 0.12; on FURY 2 "
+                       "write geometry.normals.data and call its update_range()), or store none",
     "unannounced": "vertex data changed without telling the renderer, which keeps drawing the old data: call "
                    "utils.update_actor (FURY 0.12); on FURY 2 call update_range (or update_full) on every buffer "
                    "changed, positions and normals, covering each changed range",
@@ -85,7 +89,7 @@ DIAGNOSES = {name: text for name, (text, _) in attach_mod.VARIANTS.items() if na
 #: Measured on the zoo's injected mistakes (``python -m conformance confusion``, docs/confusion.md).
 LEAD_ORDER = ("before-own-move", "late-or-own-move", "skipped", "previous-step", "wxyz", "scalar-first", "euler-order", "radians-as-degrees",
               "float32-angle-axis", "conjugate", "translation-only", "written-back", "unannounced", "stale-gpu",
-              "node-order", "face-order", "drawn-as-rigid", "stale-normals", "hidden", "scaled", "mesh-scale", "com-frame", "visual-frame",
+              "node-order", "face-order", "drawn-as-rigid", "stale-normals", "surface-normals", "hidden", "scaled", "mesh-scale", "com-frame", "visual-frame",
               "offset-sign", "turned-shape", "never-moved", "other-body", "not-its-shape")
 
 

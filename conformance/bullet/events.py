@@ -1,4 +1,4 @@
-"""Things that happen to a scene between syncs: teleports, joint resets and kicks.
+"""Things that happen to a scene between syncs: teleports, joint resets and kicks, of rigid and soft bodies.
 
 Each event is applied before the step of its frame (so frame ``n``'s sync sees its effect); a
 teleport at frame 0 moves a body after the actors were built and before the first sync. Events
@@ -16,12 +16,18 @@ from typing import Sequence
 
 import pybullet
 
-__all__ = ["LIFT", "Event", "JointReset", "Kick", "Teleport", "dumps", "loads", "turning_everything"]
+__all__ = ["LIFT", "Event", "JointReset", "Kick", "SoftKick", "SoftTeleport", "Teleport", "dumps", "loads",
+           "turning_everything"]
 
 
 def _bodies(scene) -> list[int]:
-    """The rigid bodies events act on: a soft body has no one pose to teleport or velocity to kick."""
+    """The rigid bodies :class:`Teleport`, :class:`Kick` and :class:`JointReset` act on."""
     return sorted({b.body for b in scene.bindings if not b.soft})
+
+
+def _soft_bodies(scene) -> list[int]:
+    """The soft bodies :class:`SoftTeleport` and :class:`SoftKick` act on."""
+    return sorted({b.body for b in scene.bindings if b.soft})
 
 
 def _joints(scene) -> list[tuple[int, int]]:
@@ -38,7 +44,7 @@ def _joints(scene) -> list[tuple[int, int]]:
 @dataclass(frozen=True)
 class Teleport:
     """``resetBasePositionAndOrientation`` of a body to ``position``/``orientation`` (relative to where
-    it is, for ``position``, so that a teleported body stays in view)."""
+    it is, for ``position``, so that a teleported body stays in view). No-op without rigid bodies."""
 
     frame: int
     which: int
@@ -46,10 +52,17 @@ class Teleport:
     orientation: tuple[float, float, float, float]
 
     def apply(self, scene) -> None:
-        bodies = _bodies(scene)
-        body = bodies[self.which % len(bodies)]
-        pos, _ = scene.p.getBasePositionAndOrientation(body)
-        scene.p.resetBasePositionAndOrientation(body, [a + b for a, b in zip(pos, self.offset)], list(self.orientation))
+        _teleport(scene, _bodies(scene), self.which, self.offset, self.orientation)
+
+
+def _teleport(scene, bodies: list[int], which: int, offset, orientation) -> None:
+    """``resetBasePositionAndOrientation`` of body ``which`` (modulo) of ``bodies`` by ``offset`` from where it is, to
+    ``orientation``; nothing without bodies (a world of soft bodies, or of static ones in an app)."""
+    if not bodies:
+        return
+    body = bodies[which % len(bodies)]
+    pos, _ = scene.p.getBasePositionAndOrientation(body)
+    scene.p.resetBasePositionAndOrientation(body, [a + b for a, b in zip(pos, offset)], list(orientation))
 
 
 @dataclass(frozen=True)
@@ -78,7 +91,7 @@ class Kick:
     """One step of ``applyExternalForce`` (at ``offset`` from the centre of mass) and
     ``applyExternalTorque``, both WORLD_FRAME, sized to change the base's velocity by about
     ``velocity`` (m/s) and its angular velocity by about ``spin`` (rad/s): sets a body moving and
-    spinning whatever its mass and inertia."""
+    spinning whatever its mass and inertia. No-op without rigid bodies."""
 
     frame: int
     which: int
@@ -90,6 +103,8 @@ class Kick:
         from conformance.bullet import poses
 
         bodies = _bodies(scene)
+        if not bodies:
+            return
         body = bodies[self.which % len(bodies)]
         info = scene.p.getDynamicsInfo(body, -1)
         mass, inertia = info[0], info[2]
@@ -105,8 +120,44 @@ class Kick:
         scene.p.applyExternalTorque(body, -1, [float(t) for t in torque], pybullet.WORLD_FRAME)
 
 
-Event = Teleport | JointReset | Kick
-_KINDS = {"teleport": Teleport, "joint_reset": JointReset, "kick": Kick}
+@dataclass(frozen=True)
+class SoftTeleport:
+    """``resetBasePositionAndOrientation`` of a soft body, which moves and turns every node as one rigid piece
+    (measured on pybullet 3.2.7, cloth, soft ball and both jelly blocks: the nodes' centroid goes to the
+    position given, the nodes turn by the orientation given times the inverse of the one
+    ``getBasePositionAndOrientation`` reports, and keep their shape to 1e-15 m). Here the centroid moves by
+    ``offset`` (its height by ``abs(offset[2])``, so that a body is never pushed into the ground) and the body
+    turns to ``orientation``. No-op in a scene without soft bodies."""
+
+    frame: int
+    which: int
+    offset: tuple[float, float, float]
+    orientation: tuple[float, float, float, float]
+
+    def apply(self, scene) -> None:
+        dx, dy, dz = self.offset
+        _teleport(scene, _soft_bodies(scene), self.which, (dx, dy, abs(dz)), self.orientation)
+
+
+@dataclass(frozen=True)
+class SoftKick:
+    """``resetBaseVelocity`` of a soft body to ``velocity`` (m/s): every node's velocity is set to it (measured:
+    1 m/s moves each node 1/240 m in the next step of 1/240 s). pyBullet offers no other push: forces
+    (``applyExternalForce``) do nothing to a soft body. No-op in a scene without soft bodies."""
+
+    frame: int
+    which: int
+    velocity: tuple[float, float, float]
+
+    def apply(self, scene) -> None:
+        bodies = _soft_bodies(scene)
+        if bodies:
+            scene.p.resetBaseVelocity(bodies[self.which % len(bodies)], list(self.velocity), [0.0, 0.0, 0.0])
+
+
+Event = Teleport | JointReset | Kick | SoftTeleport | SoftKick
+_KINDS = {"teleport": Teleport, "joint_reset": JointReset, "kick": Kick, "soft_teleport": SoftTeleport,
+          "soft_kick": SoftKick}
 
 
 def dumps(events: Sequence[Event]) -> str:
@@ -137,12 +188,15 @@ def loads(text: str) -> list[Event]:
 LIFT = (0.0, 0.0, 0.05)
 
 
-def turning_everything(bodies: int, turns) -> list:
-    """Events turning every one of ``bodies`` bodies, static ones too, and every joint to the orientations
-    ``turns`` (cycled) at frame 0, before the first sync; and turning every body again (``turns``
-    reversed) and lifting it a little at frame 1, after the first sync: a body the sync places once, or
-    only while it has velocity, is then drawn where it was (the orientation check's events)."""
+def turning_everything(bodies: int, turns, soft_bodies: int = 0) -> list:
+    """Events turning every one of ``bodies`` rigid bodies, static ones too, every one of ``soft_bodies`` soft
+    bodies, and every joint to the orientations ``turns`` (cycled) at frame 0, before the first sync; and
+    turning every body again (``turns`` reversed) and lifting it a little at frame 1, after the first sync:
+    a body the sync places once, or only while it has velocity, is then drawn where it was, and a soft body
+    drawn in the frame it was loaded in is drawn turned the wrong way (the orientation check's events)."""
     again = turns[::-1]
     events: list = [Teleport(0, i, (0.0, 0.0, 0.0), turns[i % len(turns)]) for i in range(bodies)]
+    events += [SoftTeleport(0, i, (0.0, 0.0, 0.0), turns[i % len(turns)]) for i in range(soft_bodies)]
     events += [JointReset(0, i, 1.0, turns[i % len(turns)]) for i in range(8)]
-    return events + [Teleport(1, i, LIFT, again[i % len(again)]) for i in range(bodies)]
+    events += [Teleport(1, i, LIFT, again[i % len(again)]) for i in range(bodies)]
+    return events + [SoftTeleport(1, i, LIFT, again[i % len(again)]) for i in range(soft_bodies)]

@@ -11,7 +11,7 @@ import math
 import numpy as np
 from hypothesis import strategies as st
 
-from conformance.bullet.events import JointReset, Kick, Teleport
+from conformance.bullet.events import JointReset, Kick, SoftKick, SoftTeleport, Teleport
 
 __all__ = [
     "HARD_ORIENTATIONS",
@@ -22,6 +22,7 @@ __all__ = [
     "offsets",
     "orientations",
     "scene_parameters",
+    "soft_events",
     "uniform_orientations",
 ]
 
@@ -98,7 +99,7 @@ def frame_counts(longest: int = 60, shortest: int = 0) -> st.SearchStrategy[int]
     return st.one_of(st.sampled_from([n for n in (0, 1, 2) if n >= shortest]), st.integers(shortest, longest))
 
 
-def _events_at(frames: int):
+def _events_at(frames: int, soft: bool = False):
     frame = st.integers(0, max(frames, 0))
     which = st.integers(0, 1000)
     teleports = st.builds(Teleport, frame=frame, which=which, offset=offsets(), orientation=orientations())
@@ -106,20 +107,37 @@ def _events_at(frames: int):
                              orientation=orientations())
     kicks = st.builds(Kick, frame=frame, which=which, velocity=offsets(3.0), offset=offsets(0.05),
                       spin=offsets(20.0))
+    if soft:
+        return st.one_of(teleports, joint_resets, kicks, soft_events(frames))
     return st.one_of(teleports, joint_resets, kicks)
+
+
+def soft_events(frames: int) -> st.SearchStrategy:
+    """One teleport (moved up to 0.5 m, turned to any orientation) or kick (up to 3 m/s) of a soft body at a
+    frame of 0..``frames`` (:class:`~conformance.bullet.events.SoftTeleport`, ``SoftKick``)."""
+    frame = st.integers(0, max(frames, 0))
+    which = st.integers(0, 1000)
+    return st.one_of(st.builds(SoftTeleport, frame=frame, which=which, offset=offsets(), orientation=orientations()),
+                     st.builds(SoftKick, frame=frame, which=which, velocity=offsets(3.0)))
 
 
 def app_events(ticks: int, most: int = 4) -> st.SearchStrategy[list]:
     """Events for an app (:mod:`conformance.apps.perturb`): as :func:`events`, at ticks 1..``ticks``-1, so
-    that each is applied before one of the app's callbacks and the last tick shows its effect."""
+    that each is applied before one of the app's callbacks and the last tick shows its effect; then up to
+    one teleport or kick of a soft body (a no-op in an app without one), drawn after the others so that
+    an app of rigid bodies meets the same rigid events as before soft events were drawn."""
     import dataclasses
 
-    return events(max(ticks - 1, 1), most).map(lambda es: [dataclasses.replace(e, frame=max(e.frame, 1)) for e in es])
+    frames = max(ticks - 1, 1)
+    drawn = st.tuples(events(frames, most), st.lists(soft_events(frames), max_size=1))
+    return drawn.map(lambda both: sorted([dataclasses.replace(e, frame=max(e.frame, 1)) for e in both[0] + both[1]],
+                                         key=lambda e: e.frame))
 
 
-def events(frames: int, most: int = 4) -> st.SearchStrategy[list]:
-    """Up to ``most`` teleports, joint resets and kicks at frames 0..``frames``, in frame order."""
-    return st.lists(_events_at(frames), max_size=most).map(lambda es: sorted(es, key=lambda e: e.frame))
+def events(frames: int, most: int = 4, soft: bool = False) -> st.SearchStrategy[list]:
+    """Up to ``most`` teleports, joint resets and kicks at frames 0..``frames``, in frame order; with ``soft``
+    (a scene with soft bodies), teleports and kicks of soft bodies among them."""
+    return st.lists(_events_at(frames, soft), max_size=most).map(lambda es: sorted(es, key=lambda e: e.frame))
 
 
 def scene_parameters(name: str) -> st.SearchStrategy[dict]:

@@ -238,7 +238,8 @@ def _pose(frames, i):
 
 def _event_name(event) -> str:
     name = type(event).__name__
-    return {"Teleport": "teleport", "JointReset": "joint reset", "Kick": "kick"}.get(name, name.lower())
+    return {"Teleport": "teleport", "JointReset": "joint reset", "Kick": "kick", "SoftTeleport": "soft-body teleport",
+            "SoftKick": "soft-body kick"}.get(name, name.lower())
 
 
 def explain(run, drawn: Drawn, tolerance: float) -> tuple[str, str] | None:
