@@ -209,37 +209,35 @@ INSTEAD = {
 }
 
 
-def _nodes(p: BoundClient, body: int, call, read: _Read) -> int:
+def _nodes(p: BoundClient, body: int, call, read: _Read) -> tuple[int, tuple]:
     """How many simulated nodes ``body`` has if it is a soft body (``loadSoftBody``, ``loadURDF`` of a
-    deformable), else 0 (-1: its nodes could not be read). pyBullet has no call that says so: a soft body is
-    one whose collision shapes it cannot report (``getCollisionShapeData`` raises) and whose simulation mesh
-    it can."""
+    deformable), else 0 (-1: its nodes could not be read), and the nodes. pyBullet has no call that says so: a
+    soft body is one whose collision shapes it cannot report (``getCollisionShapeData`` raises) and whose
+    simulation mesh it can."""
     try:
         call(pybullet.getCollisionShapeData, body, -1, physicsClientId=p.client)
-        return 0
+        return 0, ()
     except guarded.Refused:
-        return 0  # a crash is no "cannot report": a rigid body, whose base read is refused again, and said, below
+        return 0, ()  # a crash is no "cannot report": a rigid body, whose base read is refused again, and said, below
     except pybullet.error:
         pass
     try:
-        return int(call(pybullet.getMeshData, body, -1, flags=pybullet.MESH_DATA_SIMULATION_MESH, physicsClientId=p.client)[0])
+        count, nodes = call(pybullet.getMeshData, body, -1, flags=pybullet.MESH_DATA_SIMULATION_MESH, physicsClientId=p.client)
+        return int(count), tuple(nodes)
     except guarded.Refused as refusal:
         read.refused.append((None, refusal, INSTEAD["simulation mesh"]))
-        return -1
+        return -1, ()
     except pybullet.error:
-        return 0
+        return 0, ()
 
 
-def _nodes_shown(p: BoundClient, body: int, count: int, call) -> tuple:
-    """For each of a soft body's ``count`` nodes, whether pyBullet's own renderer draws it: 1 where a corner of
+def _nodes_shown(p: BoundClient, body: int, nodes: tuple, count: int, call) -> tuple:
+    """For each of a soft body's ``count`` ``nodes``, whether pyBullet's own renderer draws it: 1 where a corner of
     the body's visual mesh (``getMeshData`` without ``MESH_DATA_SIMULATION_MESH``) lies on it, 0 where none does
     (a node inside a tetrahedral body: its visual mesh is the boundary's faces, each corner at a node, measured to
     the bit); -1 each where that cannot be told (no corner on any node: a surface body from an OBJ file before
     its first step, whose visual mesh is the file's vertices unmoved; or a read that failed)."""
-    if count <= 0:
-        return ()
     try:
-        nodes = call(pybullet.getMeshData, body, -1, flags=pybullet.MESH_DATA_SIMULATION_MESH, physicsClientId=p.client)[1]
         corners = set(map(tuple, call(pybullet.getMeshData, body, -1, physicsClientId=p.client)[1]))
     except (guarded.Refused, pybullet.error):
         return (-1,) * count
@@ -251,9 +249,10 @@ def _read(p: BoundClient, body: int, call) -> _Read:
     """Every read :func:`frames_of` makes of ``body``; those that can crash pyBullet through ``call``."""
     base_name, body_name = (_text(v) for v in p.getBodyInfo(body))
     read = _Read(p.client, body, body_name if body_name and body_name != base_name else base_name)
-    read.nodes = _nodes(p, body, call, read)
+    read.nodes, nodes = _nodes(p, body, call, read)
+    if read.nodes > 0:
+        read.shown = _nodes_shown(p, body, nodes, read.nodes, call)
     if read.nodes:
-        read.shown = _nodes_shown(p, body, read.nodes, call)
         return read
     try:
         read.visuals = call(pybullet.getVisualShapeData, body, physicsClientId=p.client)
@@ -308,7 +307,7 @@ def frames_of(clients, notes: list | None = None) -> list[Frame]:
             notes.extend(_note(read, *refused) for refused in read.refused)
         if read.nodes:
             frames.extend(Frame(read.client, read.body, -1, read.name, float("nan"), (), node=n, shown=shown)
-                          for n, shown in zip(range(max(read.nodes, 0)), read.shown or (-1,) * max(read.nodes, 0)))
+                          for n, shown in enumerate(read.shown))
             continue
         visuals, shown = _visuals(read.visuals), _shown(read.visuals)
         unknown = any(instead == INSTEAD["getVisualShapeData"] for *_, instead in read.refused)

@@ -759,14 +759,13 @@ class _Judgement:
         outside = off > surface_normals.ANGLE
         if outside.any():
             verdict.passed = False
-            ticks, vertices = np.nonzero(outside)
+            ticks, vertices = np.flatnonzero(outside.any(axis=1)), np.flatnonzero(outside.any(axis=0))
             tick, vertex = np.unravel_index(int(np.argmax(off)), off.shape)
-            frames = sorted({self.r.frames[f].label.replace(f" node {self.r.frames[f].node}", "")
-                             for f in a.frame[np.unique(vertices)].tolist()})
+            bodies = sorted({self.r.frames[f].label.replace(f" node {self.r.frames[f].node}", "") for f in a.frame[vertices].tolist()})
             verdict.lines.append(
-                f"{track.label} normals: {len(np.unique(vertices))} of {int(on_nodes.sum())} vertices that follow "
-                f"{', '.join(frames)} are not the normals of the surface drawn, from tick {int(ticks.min()) + 1} on "
-                f"{len(np.unique(ticks))} of {off.shape[0]} ticks; the most, vertex {vertex} at tick {tick + 1}: "
+                f"{track.label} normals: {len(vertices)} of {int(on_nodes.sum())} vertices that follow "
+                f"{', '.join(bodies)} are not the normals of the surface drawn, from tick {int(ticks[0]) + 1} on "
+                f"{len(ticks)} of {off.shape[0]} ticks; the most, vertex {vertex} at tick {tick + 1}: "
                 f"{np.degrees(off[tick, vertex]):.3g}° outside the faces that meet there (allowed "
                 f"{np.degrees(surface_normals.ANGLE):.3g}°)")
             verdict.diagnosed("surface-normals")

@@ -4,8 +4,8 @@ An app's bodies move only as its story goes: a wall that tips about one axis nev
 angles applied in the wrong order turn a body about the wrong axes. Because the kit drives the app's
 loop, it can do to the app what it does to its scenes (:mod:`conformance.bullet.events`): before the app's
 callback of tick ``k``, turn a body to a hard orientation, kick it, or reset a joint, or teleport or kick a
-soft body (every node at once), so that the app's sync has to draw poses its story never produces. Every event is applied on every pyBullet client of the
-app that has bodies (an app may keep an empty client, or one per world). Events name bodies by position
+soft body (every node at once), so that the app's sync has to draw poses its story never produces. Every
+event is applied on every pyBullet client of the app that has bodies (an app may keep an empty client, or one per world). Events name bodies by position
 in the list of a client's *dynamic* bodies (``which`` modulo its length; static bodies are left where the app put them,
 so an app may draw them as part of the world) and joints by position in the list of movable joints,
 and are drawn by Hypothesis (:func:`conformance.checks.strategies.app_events`), so a failure is reproducible from its JSON.

@@ -123,9 +123,8 @@ def soft_events(frames: int) -> st.SearchStrategy:
 
 def app_events(ticks: int, most: int = 4) -> st.SearchStrategy[list]:
     """Events for an app (:mod:`conformance.apps.perturb`): as :func:`events`, at ticks 1..``ticks``-1, so
-    that each is applied before one of the app's callbacks and the last tick shows its effect; then up to
-    one teleport or kick of a soft body (a no-op in an app without one), drawn after the others so that
-    an app of rigid bodies meets the same rigid events as before soft events were drawn."""
+    that each is applied before one of the app's callbacks and the last tick shows its effect; and up to
+    one teleport or kick of a soft body (a no-op in an app without one)."""
     import dataclasses
 
     frames = max(ticks - 1, 1)
