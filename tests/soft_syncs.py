@@ -18,7 +18,7 @@ from conformance.implementations.frames import SoftBodies
 from conformance.implementations.reference import ReferenceSync
 
 __all__ = ["CopiedOnce", "EveryNode", "Float16Nodes", "LoadFrameNodes", "MovesTheCloth", "NodesReversed", "OneStepLateNodes",
-           "PartlyCopied", "StillsTheNodes", "VisualMesh"]
+           "PartlyCopied", "PosedAsWell", "StillsTheNodes", "VisualMesh"]
 
 
 class _LateNodes(SoftBodies):
@@ -108,6 +108,23 @@ class Float16Nodes(ReferenceSync):
     """
 
     soft_bodies = _Float16
+
+
+class _PosedAsWell(SoftBodies):
+    def vertices(self, t, nodes):
+        pos, orn = pybullet.getBasePositionAndOrientation(t.body, physicsClientId=self.client)
+        return nodes[t.nodes] @ Rotation.from_quat(orn).as_matrix().T + pos
+
+
+class PosedAsWell(ReferenceSync):
+    """Wrong: copies the nodes, and moves them by the soft body's getBasePositionAndOrientation as well, as the
+    program's rigid bodies are posed (one recipe for every body: what an actor given the body's pose draws).
+    The nodes are already in the world's frame, so the cloth is drawn moved and turned a second time.
+
+    Diagnosis: soft-posed
+    """
+
+    soft_bodies = _PosedAsWell
 
 
 class _Visual(SoftBodies):

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from app_recordings import CORNERS, TICKS, box_frame, draw, motion, recording, track
+from app_recordings import CORNERS, HALF, TICKS, box_frame, draw, motion, recording, track
 from conformance.apps import judge, placement
 from conformance.apps.bodies import Frame
 
@@ -595,3 +595,44 @@ def test_a_change_announced_outside_its_range_is_named_stale_gpu_and_one_never_a
         verdict = judge(recording([box_frame()], [(pos, orn)], [never]))["announced"]
         assert not verdict.passed and verdict.diagnoses == ["unannounced"], verdict.message()
 
+
+
+def _pendulum(offset: float):
+    """A box hung ``offset`` below its link frame (a pendulum's bob; 0: the box at the origin), the frame turning
+    about the world's y axis back and forth, as a planar robot's links and a cart-pole's pole do."""
+    centre = (0.0, 0.0, -offset)
+    frame = Frame(0, 0, -1, "pole", 1.0, (("box", tuple(2 * HALF), centre, (0.0, 0.0, 0.0, 1.0)),), (0.0, 0.0, 0.0))
+    angles = 0.8 * np.sin(np.arange(TICKS + 1) / 9.0) + 0.3
+    orn = Rotation.from_rotvec(np.outer(angles, [0.0, 1.0, 0.0])).as_quat()
+    pos = np.tile([0.0, 0.0, 1.0], (TICKS + 1, 1))
+    return frame, pos, orn, CORNERS + centre
+
+
+@pytest.mark.parametrize("offset", [0.3, 0.0])
+@pytest.mark.parametrize("mistake", ["wxyz", "conjugate"])
+def test_a_link_turning_about_y_is_named_by_where_its_shape_lies(mistake, offset):
+    """About the world's y axis a quaternion reordered (w, x, y, z) turns a link as the inverse rotation turns
+    its shape flipped about x, tick for tick: the drawing's motion cannot tell the two apart, where its shape
+    lies can. A bob hung below its frame is named by the mistake made; a box at the frame's origin, which the
+    flip leaves as it was, is named neither (issue 48: a diagnosis is right or silent)."""
+    frame, pos, orn, geometry = _pendulum(offset)
+    turned = np.roll(orn, 1, axis=1) if mistake == "wxyz" else Rotation.from_quat(orn).inv().as_quat()
+    verdicts = judge(recording([frame], [(pos, orn)], [track(draw(pos, turned, geometry))]))
+    assert "attached" in _failing(verdicts)
+    named = {d for v in verdicts.values() for d in v.diagnoses}
+    if offset:
+        assert named == {mistake}, verdicts["attached"].message()
+    else:
+        assert not named & {"wxyz", "conjugate"}, verdicts["attached"].message()
+
+
+def test_a_drawing_far_from_its_shape_and_on_no_other_names_no_other_body():
+    """``other-body`` says a drawing was paired with another body: named only where the part drawn off its
+    frame's shape lies on another frame's shapes. The same box carried 1 m off its own, in empty space (a
+    frame composed some way the catalogue does not know), gets no name (issue 48: right or silent)."""
+    a, b = motion(seed=1), motion(seed=2, offset=(0.0, 3.0, 0.0))
+    offset = np.array([1.0, 0.0, 0.0])
+    drawn = np.concatenate([draw(*a), draw(*a, CORNERS + offset)], axis=1)
+    verdicts = judge(recording([box_frame(0), box_frame(1)], [a, b], [track(drawn), track(draw(*b), label="other")]))
+    assert "placed" in _failing(verdicts) and "reaches" in verdicts["placed"].message(), verdicts["placed"].message()
+    assert verdicts["placed"].diagnoses == [], verdicts["placed"].message()

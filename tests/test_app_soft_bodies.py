@@ -165,3 +165,26 @@ def test_a_soft_body_drawn_as_one_rigid_piece_is_told_from_one_that_deforms():
     squashed[..., 2] *= np.linspace(1.0, 0.7, 20)[:, None]  # flattened a little more each tick
     assert not soft_bodies._rigid(squashed, 1e-6)
     assert not soft_bodies._rigid(np.repeat(block[None], 20, axis=0), 1e-6)  # never moved: another mistake
+
+
+def test_a_soft_bodys_nodes_moved_again_by_a_pose_are_told_from_its_nodes_and_from_a_rigid_piece():
+    """``soft-posed``: at every tick the vertices are the nodes, moved by one rigid pose that does move them (an
+    actor given the soft body's getBasePositionAndOrientation on top of its copied nodes), paired in the
+    actor's order or, when the actor has more vertices than nodes, by the nearest node once their centres meet.
+    The nodes themselves, or a rigid piece that does not deform as the nodes do, are not."""
+    import numpy as np
+    from scipy.spatial.transform import Rotation
+
+    from conformance.apps import soft_bodies
+
+    rng = np.random.default_rng(1)
+    start = rng.uniform(-0.2, 0.2, (25, 3))
+    nodes = np.stack([start * [1.0, 1.0, 1.0 - 0.02 * t] + [0.0, 0.0, -0.01 * t] for t in range(20)])  # sagging
+    turns = Rotation.from_rotvec(np.outer(np.linspace(0, 0.5, 20), [0.2, 1.0, 0.1]))
+    posed = np.stack([turn.apply(now) + [0.05 * t, 0.0, 1.0] for t, (turn, now) in enumerate(zip(turns, nodes))])
+    rows = np.arange(25)
+    assert soft_bodies._posed(posed, rows, nodes, 1e-6)
+    assert soft_bodies._posed(posed[:, ::-1], rows, nodes, 1e-6)  # built in another order: paired by the nearest node
+    assert not soft_bodies._posed(nodes, rows, nodes, 1e-6)  # the nodes as they are: drawn right, no pose
+    rigid = np.stack([turn.apply(start) + [0.05 * t, 0.0, 1.0] for t, turn in enumerate(turns)])
+    assert not soft_bodies._posed(rigid, rows, nodes, 1e-6)  # posed as if rigid: `drawn-as-rigid`, not this

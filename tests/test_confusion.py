@@ -93,6 +93,10 @@ def test_a_diagnosis_kept_as_text_is_counted_by_its_name():
     assert diagnosis.name_of(late) == "late-or-once"  # two mistakes not told apart yet: counted as neither
     assert confusion.cell("never-moved", "late-or-once") == confusion.cell("previous-step", "late-or-once") == "none"
     assert confusion.cell("-", "late-or-once") == "other:late-or-once"
+    posed = diagnosis.SOFT_WORDS["rigid-or-posed"].format(name="'cloth'")
+    assert diagnosis.name_of(posed) == "rigid-or-posed"
+    assert confusion.cell("drawn-as-rigid", "rigid-or-posed") == confusion.cell("soft-posed", "rigid-or-posed") == "none"
+    assert confusion.cell("-", "rigid-or-posed") == "other:rigid-or-posed"
     told = diagnosis.SOFT_WORDS["never-moved"] + " (told at frame 2: at frame 1 the two draw alike)"
     assert diagnosis.name_of(told) == "never-moved"  # a note after the words is not part of them
     assert diagnosis.name_of("diagnosis: something the catalogue never wrote") == ""

@@ -37,6 +37,7 @@ SOFT = {"cloth": "cloth", "soft_ball": "ball", "jelly": "jelly(?:_urdf)?"}
     ("soft_syncs:PartlyCopied", 1, r"only \d+ of the soft body's \d+ vertices follow its nodes"),
     ("soft_syncs:Float16Nodes", 0, "drawn at the soft body's nodes rounded to float16"),
     ("soft_syncs:VisualMesh", 0, r"drawn at the soft body's visual mesh \(getMeshData without MESH_DATA_SIMULATION_MESH"),
+    ("soft_syncs:PosedAsWell", 0, r"drawn at the soft body's nodes moved again by the body's pose"),
 ])
 def test_every_frame_check_fails_on_a_wrong_soft_body(spec, frame, diagnosis, scene_name):
     body = SOFT[scene_name]

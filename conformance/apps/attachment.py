@@ -33,7 +33,7 @@ from scipy.spatial.transform import Rotation
 from conformance.bullet import poses
 from conformance.judge.tolerances import DEFAULT, Tolerance
 
-__all__ = ["ALIASES", "Attachment", "VARIANTS", "attach", "in_frame", "local_coordinates", "variant_fit", "visual_order"]
+__all__ = ["ALIASES", "Attachment", "TURNS", "VARIANTS", "attach", "in_frame", "local_coordinates", "variant_fit", "visual_order"]
 
 #: nearest frames (by origin, at the first judged tick) tried first for each vertex, then more of
 #: them for a vertex none of those holds, then all of them (so a range following a far body is found)
@@ -554,6 +554,11 @@ VARIANTS = {
 
 
 #: Variants that are another form of a mistake named before them: the name a diagnosis gives them.
+#: The variants that differ from pyBullet's pose by the rotation alone: more than one of them can hold one
+#: drawing (:meth:`conformance.apps.judge._Judgement._turn_on_its_shape` tells them apart)
+TURNS = ("conjugate", "wxyz", "scalar-first", "euler-order", "translation-only", "radians-as-degrees",
+         "radians-as-degrees, Euler", "float32-angle-axis")
+
 ALIASES = {"radians-as-degrees, Euler": "radians-as-degrees", "visual-frame, order": "visual-frame",
            "previous-step, tick": "previous-step"}
 

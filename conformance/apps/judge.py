@@ -42,6 +42,15 @@ UNTOUCHED_ATOL = 1e-12
 POSE_WRITERS = {"resetBasePositionAndOrientation", "resetJointState", "resetJointStateMultiDof", "resetJointStatesMultiDof"}
 #: :meth:`_Judgement._owners`' mistake index of the pose before the app's own moves: one past the catalogue
 _OWN_MOVE = len(attach_mod.VARIANTS) + 1
+#: Of two rotation mistakes that hold a drawing alike, the one made is the one under which the drawing lies on its
+#: frame's shapes (its vertices on average within this share of its reach of them) while under every other it
+#: lies off them (past the second share): the other puts the shape flipped, a link's length off its origin
+#: (cartpole's pole, 0.5 m; half_cheetah's thighs). A visual mesh is judged by shapes that only approximate it,
+#: so between the two nothing is named.
+ON_ITS_SHAPE, OFF_ITS_SHAPE = 0.05, 0.25
+#: A drawing lies on a frame's shapes when its vertices are within this share of its own reach of them, on
+#: average (:meth:`_Judgement._on_another_frame`)
+ON_SHAPE = 0.25
 
 
 def _rotations(q: np.ndarray) -> np.ndarray:
@@ -78,6 +87,10 @@ class _Judgement:
         self._placements = None
         #: per actor index, the vertices `drawn` found to be a moving frame's shape left where it was built
         self.left_behind: dict[int, set] = {}
+        #: (client, body) of each soft body attached, drawn or placed found drawn wrong: its picture is then
+        #: not evidence of its triangles (``face-order``)
+        self.soft_misdrawn: set[tuple[int, int]] = set()
+        self.placed_done = False
         self._drawn_verdict = None
 
     def _outside(self, frame: int, points: np.ndarray) -> np.ndarray:
@@ -198,7 +211,7 @@ class _Judgement:
                 info = self.r.frames[frame] if frame >= 0 else None
                 if info is not None and info.node >= 0:
                     soft.setdefault((info.client, info.body, info.name, diagnosis), []).append(
-                        soft_bodies.Piece(rows, error[:, first].max(), first, error[:, k].max(), k, allowance.max()))
+                        soft_bodies.Piece(rows, error[:, first].max(), first, error[:, k].max(), k, allowance.max(), frame))
                     continue
                 if diagnosis == "late-or-own-move":
                     verdict.ties.append((index, start, stop, frame))
@@ -208,7 +221,7 @@ class _Judgement:
                     f"{error[:, first].max():.3g} m from where that frame carries it (allowed "
                     f"{allowance.max():.3g} m); worst {error[:, k].max():.3g} m at tick {k + 1}")
                 verdict.diagnosed(diagnosis)
-            soft_bodies.attached(track, a, soft, verdict)
+            soft_bodies.attached(self, track, a, soft, verdict)
             worst = max(worst, float(ratio.max(initial=0)))
         for track, bad in zip(self.r.actors, self.unfinite):
             for start, stop in _runs(bad, np.zeros(len(bad), dtype=int)):
@@ -308,6 +321,8 @@ class _Judgement:
             return (frame, diagnosis) if diagnosis else self._followed(vertices, a.frame[piece], a.reference[piece])
         if mistake:
             diagnosis = list(attach_mod.VARIANTS)[mistake - 1]
+            if diagnosis in attach_mod.TURNS:  # the first that holds it; a later one may hold it alike
+                return frame, self._turn_on_its_shape(frame, self._turns_holding(vertices, frame, diagnosis))
             diagnosis = attach_mod.ALIASES.get(diagnosis, diagnosis)
             if diagnosis == "previous-step":  # or later than the step: before the app's own moves
                 diagnosis = self._later_than_the_step(vertices, frame, a.reference[piece]) or diagnosis
@@ -393,8 +408,9 @@ class _Judgement:
         if own:
             return own
         possible = self._variants_possible(vertices, frame, reference, allowance, bad_ticks)
+        turns = []  # the rotation mistakes that hold the vertices: (name, their own place in that frame)
         for name, (positions, rotations), could in zip(attach_mod.VARIANTS, self._variants, possible):
-            if not could:
+            if not could or (turns and name not in attach_mod.TURNS):
                 continue
             positions, rotations = positions[:, frame, None], rotations[:, frame, None]
             if attach_mod.variant_fit(vertices, positions, rotations, reference, allowance, bad_ticks):
@@ -402,10 +418,46 @@ class _Judgement:
                 if name == "previous-step" and not attach_mod.variant_fit(
                         vertices, positions, rotations, reference, allowance, np.arange(len(vertices))):
                     return "skipped"
-                return attach_mod.ALIASES.get(name, name)
+                if name not in attach_mod.TURNS:
+                    return attach_mod.ALIASES.get(name, name)
+                turns.append((attach_mod.ALIASES.get(name, name),
+                              np.median(attach_mod.local_coordinates(vertices, positions, rotations), axis=0)))
+        if turns:
+            return self._turn_on_its_shape(frame, turns)
         if self._visual_order_fits(vertices, frame, reference, allowance, bad_ticks):
             return "visual-frame"
         return "skipped" if self._skipped(vertices, frame, allowance) else ""
+
+    def _turns_holding(self, vertices, frame: int, first: str) -> list:
+        """``(name, own place)`` of the rotation mistakes from ``first`` on (a key of the catalogue, which holds
+        ``vertices``) that hold them in ``frame``, each at one fixed place of its own at every tick."""
+        _, allowance = self._errors(vertices, frame)
+        ticks = np.arange(len(vertices))
+        found = []
+        for name, (positions, rotations) in list(zip(attach_mod.VARIANTS, self._variants))[list(attach_mod.VARIANTS).index(first):]:
+            if name not in attach_mod.TURNS:
+                continue
+            positions, rotations = positions[:, frame, None], rotations[:, frame, None]
+            if name == first or attach_mod.variant_fit(vertices, positions, rotations, None, allowance, ticks):
+                found.append((attach_mod.ALIASES.get(name, name),
+                              np.median(attach_mod.local_coordinates(vertices, positions, rotations), axis=0)))
+        return found
+
+    def _turn_on_its_shape(self, frame: int, turns: list) -> str:
+        """Which of several rotation mistakes that each hold a drawing made it: the one under which the drawing
+        lies on its frame's shapes. Two can hold it alike: a link turning about the world's y axis drawn with
+        its quaternion reordered (w, x, y, z) is drawn as by the inverse rotation of its shape flipped about its
+        x axis, at every tick (R(wxyz of q) = R(q)ᵀ·Rx(π)), so only where the shape lies tells them apart. ""
+        when none or several lie on it (a shape the flip leaves as it was): either could be meant."""
+        if len(turns) == 1:
+            return turns[0][0]
+        own = turns[0][1]
+        if len(own) < 4:  # a few vertices of a drawing lie on a shape, or off it, whichever way it is turned
+            return ""
+        reach = max(float(np.max(np.linalg.norm(own - own.mean(axis=0), axis=1))), 1e-9)  # a turn keeps it
+        outside = np.array([float(np.mean(self._outside(frame, place))) for _, place in turns]) / reach
+        on, off = outside <= ON_ITS_SHAPE, outside > OFF_ITS_SHAPE
+        return turns[int(np.argmin(outside))][0] if on.sum() == 1 and off.sum() == len(turns) - 1 else ""
 
     def _visual_order_fits(self, vertices, frame, reference, allowance, bad_ticks) -> bool:
         """Whether one of the frame's several visual frames, composed the wrong way round with its pose, holds
@@ -661,6 +713,7 @@ class _Judgement:
         return pictured.check(self)
 
     def placed(self) -> Verdict:
+        self.placed_done = True
         verdict = Verdict("placed", True)
         soft: dict[tuple, list] = {}
         # A frame some drawing shows at its size may carry others (a halo, a marker): those are decorations.
@@ -693,6 +746,8 @@ class _Judgement:
             elif not result.ok:
                 verdict.passed = False
                 diagnosis = result.diagnosis or self._other_body(result.offset, frame)
+                if diagnosis == "other-body" and not self._on_another_frame(track, rows, frame):
+                    diagnosis = ""  # far from its shape, and on no other: a mistake the catalogue does not tell
                 verdict.lines.append(f"{where}: {result.why}")
                 verdict.diagnosed(diagnosis)
         soft_bodies.placed(self, soft, verdict)
@@ -700,6 +755,33 @@ class _Judgement:
 
     def _inertial(self, frame: int) -> np.ndarray:
         return np.asarray(self.r.frames[frame].inertial, dtype=np.float64)
+
+    def _on_another_frame(self, track, rows, frame: int) -> bool:
+        """Whether the part of the drawing of ``rows`` (held by ``frame``) that lies off ``frame``'s shapes at the
+        first tick lies on another frame's shapes instead, its centre in them: the evidence that it was paired
+        with another body (a range counted wrong draws one body's shape at the other's place where it was
+        built, then carries it with the wrong pose). A drawing far from its shape for another reason (a scale
+        applied twice, a frame composed wrong) lies on none, or is centred on its own."""
+        def local(points, f):
+            return attach_mod.in_frame(points[None], self.pos[:1, f], self.rot[:1, f])[0]
+
+        def reach(points):
+            return max(float(np.max(np.linalg.norm(points - points.mean(axis=0), axis=1))), 1e-9)
+
+        points = track.vertices[1, rows]
+        off = points[self._outside(frame, local(points, frame)) > ON_SHAPE * reach(points)]
+        if not len(off):
+            return False
+        centre, slack = off.mean(axis=0, keepdims=True), ON_SHAPE * reach(off)
+        if float(self._outside(frame, local(centre, frame))[0]) <= slack:
+            return False
+        for other, info in enumerate(self.r.frames):
+            if other == frame or info.node >= 0 or not (info.shapes or info.visuals):
+                continue
+            if float(self._outside(other, local(centre, other))[0]) <= slack and \
+                    float(np.mean(self._outside(other, local(off, other)))) <= slack:
+                return True
+        return False
 
     def _other_body(self, offset, frame) -> str:
         return "other-body" if offset is not None and np.linalg.norm(offset) > bounding_radius(self.r.frames[frame].shapes) else ""

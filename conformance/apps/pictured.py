@@ -310,6 +310,13 @@ def _diagnosis(frames: list[int], shot: dict, recording, attachments) -> str:
     return ""
 
 
+def _triangles_to_blame(judgement, frame: int) -> bool:
+    """Whether a soft body (one of its node frames) failing its picture can only be its triangles: the checks of
+    its vertices found none drawn wrong."""
+    info = judgement.r.frames[frame]
+    return (info.client, info.body) not in judgement.soft_misdrawn
+
+
 def check(judgement):
     """The ``pictured`` verdict of a :class:`~conformance.apps.judge._Judgement`, with each picture's
     comparison record and, for a failure, its three pictures (``Verdict.pictures``)."""
@@ -317,6 +324,8 @@ def check(judgement):
 
     r = judgement.r
     verdict = Verdict("pictured", True)
+    if not judgement.placed_done:
+        judgement.placed()  # which frames the vertex checks found drawn wrong (followed_badly, soft_misdrawn)
     judged, background, unlike = _statuses(judgement)
     soft = soft_labels(judgement)
     members: dict[int, list[int]] = {}
@@ -367,10 +376,13 @@ def check(judgement):
 
         def why_off(t, shot=shot):
             own = members.get(t["index"], [t["index"]])
-            # A soft body whose vertices all follow their nodes (attached) yet whose picture is not pyBullet's:
-            # its triangles join other nodes.
-            return (_diagnosis(own, shot, r, judgement.attachments) or ("not-its-shape" if t["index"] in unlike else "")
-                    or ("face-order" if t["index"] in members else ""))
+            # A soft body whose vertices all follow their nodes (attached, drawn and placed found none
+            # wrong) yet whose picture is not pyBullet's: its triangles join other nodes.
+            # A frame `attached` found drawn at a wrong pose is not pictured as its shape for that reason: its
+            # picture is not evidence of the shape drawn.
+            return (_diagnosis(own, shot, r, judgement.attachments)
+                    or ("not-its-shape" if t["index"] in unlike and t["index"] not in judgement.followed_badly else "")
+                    or ("face-order" if t["index"] in members and _triangles_to_blame(judgement, t["index"]) else ""))
         verdict.pictures.append((record, silhouettes.mask_images(fury, bullet) if failing else {}))
         explained: dict[str, int] = {}
         first = len(verdict.lines)

@@ -34,25 +34,76 @@ class Piece:
     worst_error: float
     worst_tick: int
     allowed: float
+    frame: int = -1     # the node's frame it follows best
 
 
-def attached(track, attachment, pieces: dict, verdict) -> None:
+def attached(judgement, track, attachment, pieces: dict, verdict) -> None:
     """One ``attached`` line per soft body and mistake for the loose vertices that follow its nodes
     (``pieces``: ``(client, body, name, diagnosis) -> [Piece]``): a cloth drawn one step late is one
-    mistake, not one line per vertex. Vertices named nothing that move as one rigid piece are a soft body
-    posed as a rigid one (``drawn-as-rigid``)."""
+    mistake, not one line per vertex. Vertices named nothing are named by what they are instead of the
+    nodes: the built shape moved as one rigid piece (``drawn-as-rigid``), the nodes rounded to half
+    precision (``float16``), or the nodes moved again by a pose of the actor (``soft-posed``)."""
     for (client, body, label, diagnosis), found in pieces.items():
         rows = np.concatenate([piece.rows for piece in found])
-        if not diagnosis and _rigid(track.vertices[1:, rows], max(piece.allowed for piece in found)):
-            diagnosis = "drawn-as-rigid"
+        allowed = max(piece.allowed for piece in found)
+        if not diagnosis:
+            diagnosis = _named(judgement, track, found, rows, allowed, (client, body))
         first = min(found, key=lambda piece: piece.first_tick)
         worst = max(found, key=lambda piece: piece.worst_error)
         verdict.lines.append(
             f"{track.label} ({track.kind}) vertices {vertex_ranges(rows)} of {len(attachment.frame)}: not held by "
             f"any frame; each follows a node of {name(client, body, label)} best, and the first left it at tick "
             f"{first.first_tick + 1}: {first.first_error:.3g} m from that node (allowed "
-            f"{max(piece.allowed for piece in found):.3g} m); worst {worst.worst_error:.3g} m at tick {worst.worst_tick + 1}")
+            f"{allowed:.3g} m); worst {worst.worst_error:.3g} m at tick {worst.worst_tick + 1}")
         verdict.diagnosed(diagnosis)
+        judgement.soft_misdrawn.add((client, body))
+
+
+def _named(judgement, track, found, rows, allowed: float, body: tuple) -> str:
+    """The mistake of a soft body's loose vertices that no variant of the rigid machinery names, or ""."""
+    vertices = track.vertices[1:, rows]
+    if _rigid(vertices, allowed):
+        return "drawn-as-rigid"
+    nodes = np.concatenate([np.repeat(judgement.pos[:, [piece.frame]], len(piece.rows), axis=1) for piece in found], axis=1)
+    half = nodes.astype(np.float16).astype(np.float64)
+    # named only where rounding moves a node well past the allowance: the drawing is then nearer the rounded
+    # nodes than the nodes themselves
+    if np.max(np.linalg.norm(half - nodes, axis=-1)) > 3 * allowed and \
+            np.max(np.linalg.norm(vertices - half, axis=-1)) <= allowed:
+        return "float16"
+    frames = _nodes_by_body(judgement.r.frames).get(body, [])
+    if frames and _posed(vertices, rows, judgement.pos[:, frames], allowed):
+        return "soft-posed"
+    return ""
+
+
+def _posed(vertices: np.ndarray, rows: np.ndarray, nodes: np.ndarray, allowance: float) -> bool:
+    """Whether ``vertices`` (ticks, n, 3) are the soft body's ``nodes`` (ticks, m, 3) moved again at every tick
+    by one rigid pose, a pose that does move them: what a soft body's actor draws when the program gives it
+    a pose (the body's getBasePositionAndOrientation, as for its rigid bodies) on top of the nodes, which
+    are already in the world's frame. The actor's vertex k (``rows``) pairs with node k (an actor built from
+    the nodes in their order), or with the node nearest it once the first tick's centres are put together."""
+    from scipy.spatial import cKDTree
+    from scipy.spatial.transform import Rotation
+
+    n = vertices.shape[1]
+    if n < 3 or not len(vertices):
+        return False
+    pairings = [rows] if rows.max() < nodes.shape[1] else []
+    shift = nodes[0].mean(axis=0) - vertices[0].mean(axis=0)
+    pairings.append(cKDTree(nodes[0]).query(vertices[0] + shift)[1])
+    for pairing in pairings:
+        moved, fits = False, True
+        for drawn, now in zip(vertices, nodes[:, pairing]):
+            centre, at = drawn.mean(axis=0), now.mean(axis=0)
+            turn, _ = Rotation.align_vectors(drawn - centre, now - at)
+            if np.max(np.linalg.norm(turn.apply(now - at) + centre - drawn, axis=1)) > allowance:
+                fits = False
+                break
+            moved = moved or np.max(np.linalg.norm(drawn - now, axis=1)) > 10 * allowance
+        if fits and moved:
+            return True
+    return False
 
 
 def _rigid(vertices: np.ndarray, allowance: float) -> bool:
@@ -87,7 +138,9 @@ def _nodes_by_body(frames) -> dict[tuple[int, int], list[int]]:
 def drawn(judgement, verdict, followed: set) -> None:
     """A soft body is drawn when every node of it that moves and that pyBullet draws is followed by some drawn
     vertex: a program that copies all but the last nodes, or none, leaves nodes moving with nothing drawn on
-    them. A node pyBullet does not draw (inside a tetrahedral body: ``Frame.shown`` 0) need not be drawn."""
+    them. A node pyBullet does not draw (inside a tetrahedral body: ``Frame.shown`` 0) need not be drawn.
+    Vertices left on such nodes where they were built are the mistake named: ``never-moved`` when no moving
+    node is followed, ``part-copied`` when some are (the copy stops short)."""
     r = judgement.r
     for (client, body), nodes in _nodes_by_body(r.frames).items():
         nodes = [i for i in nodes if r.frames[i].shown != 0]
@@ -95,10 +148,12 @@ def drawn(judgement, verdict, followed: set) -> None:
             continue
         allowance = 10 * judgement.tolerance.for_extents(np.zeros(len(nodes)), judgement.pos[0, nodes])
         moved = np.array([judgement._movement(i, 0.0) for i in nodes])
-        missing = [i for i, m, a in zip(nodes, moved, allowance) if m > a and i not in followed]
+        moving = [i for i, m, a in zip(nodes, moved, allowance) if m > a]
+        missing = [i for i in moving if i not in followed]
         if not missing:
             continue
         verdict.passed = False
+        judgement.soft_misdrawn.add((client, body))
         numbers = [r.frames[i].node for i in missing]
         shown = ", ".join(map(str, numbers[:8])) + (f" … ({len(numbers)} of {len(nodes)})" if len(numbers) > 8 else "")
         left = _left_at_nodes(judgement, missing)
@@ -108,26 +163,33 @@ def drawn(judgement, verdict, followed: set) -> None:
                              "flags=p.MESH_DATA_SIMULATION_MESH) into the actor after each step"
                              + (f"; {left} stay where they were built, on those nodes" if left else ""))
         if left:
-            verdict.diagnosed("never-moved")
+            copied = len(moving) - len(missing)
+            if copied:
+                verdict.lines[-1] += f" ({copied} of its {len(moving)} moving nodes are copied)"
+            verdict.diagnosed("part-copied" if copied else "never-moved")
 
 
 def _left_at_nodes(judgement, nodes: list[int]) -> str:
-    """The actor ranges held by the world that were drawn, when the loop started, on ``nodes`` (frame
-    indices): a soft body drawn once and never copied again."""
+    """The actor ranges that were drawn, when the loop started, on ``nodes`` (frame indices) and never moved:
+    a soft body drawn once and never copied again. They are held by the world, or by a frame that never
+    moves either (an anchored corner of the same cloth holds every still vertex as well), and are the
+    copy's mistake, not a drawing of that frame: :attr:`judgement.left_behind` keeps them from ``placed``."""
     from scipy.spatial import cKDTree
 
     r = judgement.r
     tree = cKDTree(r.positions[0, nodes])
     found = []
-    for track, a in zip(r.actors, judgement.attachments):
-        world = np.flatnonzero((a.frame < 0) & a.held)
-        if not len(world):
+    for index, (track, a) in enumerate(zip(r.actors, judgement.attachments)):
+        allowed = 10 * judgement.tolerance.for_extents(np.zeros(len(a.frame)), track.vertices[0])
+        still = np.max(np.linalg.norm(track.vertices - track.vertices[:1], axis=-1), axis=0) <= allowed
+        candidates = np.flatnonzero(a.held & still)
+        if not len(candidates):
             continue
-        distance, _ = tree.query(track.vertices[0, world])
-        allowed = 10 * judgement.tolerance.for_extents(np.zeros(len(world)), track.vertices[0, world])
-        on = world[distance <= allowed]
+        distance, _ = tree.query(track.vertices[0, candidates])
+        on = candidates[distance <= allowed[candidates]]
         if len(on):
             found.append(f"{track.label} vertices {vertex_ranges(on)}")
+            judgement.left_behind.setdefault(index, set()).update(on.tolist())
     return ", ".join(found)
 
 
@@ -152,6 +214,7 @@ def placed(judgement, pieces: dict, verdict) -> None:
             verdict.notes.append(f"{label} vertices {vertex_ranges(rows)} follow nodes of {soft_body}, each drawn at its node")
             continue
         verdict.passed = False
+        judgement.soft_misdrawn.add((client, body))
         worst = max(off, key=lambda piece: piece[2][0] / max(piece[2][1], 1e-300))
         off_rows = np.sort(np.concatenate([piece[0] for piece in off]))
         verdict.lines.append(

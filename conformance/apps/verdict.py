@@ -66,6 +66,16 @@ DIAGNOSES = {name: text for name, (text, _) in attach_mod.VARIANTS.items() if na
                   "than the nodes are copied into them (a mesh file read by another library reorders or merges "
                   "vertices): build the actor from getMeshData(body, -1, flags=p.MESH_DATA_SIMULATION_MESH) and copy "
                   "the nodes in that same order",
+    "part-copied": "only some of the soft body's moving nodes are copied into the actor after each step; the "
+                   "vertices of the others stay where they were built (a copy that stops short: a slice, a count "
+                   "taken from another mesh): copy every node of getMeshData(body, -1, "
+                   "flags=p.MESH_DATA_SIMULATION_MESH) into the actor after each step",
+    "float16": "drawn at the soft body's nodes rounded to float16 (half precision: 11 bits, a millimetre at two "
+               "metres): store the nodes as float32 or float64",
+    "soft-posed": "drawn at the soft body's nodes moved again by a pose given to its actor (SetPosition or "
+                  "SetUserMatrix on FURY 0.12, local.position or local.rotation on FURY 2: the rigid bodies' "
+                  "getBasePositionAndOrientation recipe applied to a soft body too): getMeshData's nodes are "
+                  "already in the world's frame, so leave a soft body's actor at the identity pose",
     "face-order": "every vertex follows a node of this soft body, but its triangles are not pyBullet's: the faces were "
                   "built for another order of the vertices than the one the nodes are copied in (np.unique sorts what it "
                   "returns; mesh libraries merge or reorder vertices): build the faces for the node order of "
@@ -89,7 +99,7 @@ DIAGNOSES = {name: text for name, (text, _) in attach_mod.VARIANTS.items() if na
 #: Measured on the zoo's injected mistakes (``python -m conformance confusion``, docs/confusion.md).
 LEAD_ORDER = ("before-own-move", "late-or-own-move", "skipped", "previous-step", "wxyz", "scalar-first", "euler-order", "radians-as-degrees",
               "float32-angle-axis", "conjugate", "translation-only", "written-back", "unannounced", "stale-gpu",
-              "node-order", "face-order", "drawn-as-rigid", "stale-normals", "surface-normals", "hidden", "scaled", "mesh-scale", "com-frame", "visual-frame",
+              "node-order", "soft-posed", "float16", "part-copied", "face-order", "drawn-as-rigid", "stale-normals", "surface-normals", "hidden", "scaled", "mesh-scale", "com-frame", "visual-frame",
               "offset-sign", "turned-shape", "never-moved", "other-body", "not-its-shape")
 
 

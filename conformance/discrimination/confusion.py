@@ -49,6 +49,7 @@ class Case:
 
 #: Names that say two mistakes cannot be told apart yet: none of the two is named, and neither is wrong.
 UNDECIDED = {"late-or-once": {"previous-step", "never-moved"},
+             "rigid-or-posed": {"drawn-as-rigid", "soft-posed"},
              "late-or-own-move": {"previous-step", "before-own-move"}}
 
 

@@ -25,7 +25,7 @@ import pybullet
 
 from conformance.bullet import poses, truth
 
-__all__ = ["EULER_ORDERS", "MISTAKES", "NORMAL_MISTAKES", "SOFT_WORDS", "Drawn", "diagnose", "diagnose_frame",
+__all__ = ["EULER_ORDERS", "MISTAKES", "NORMAL_MISTAKES", "SOFT_WORDS", "UNDECIDED", "Drawn", "diagnose", "diagnose_frame",
            "diagnose_normals", "diagnose_problems", "drawn_now", "explain", "explain_failures", "explain_frame",
            "explain_normals", "late_or_once", "name_of", "soft_drawn_as_rigid", "soft_names", "unannounced"]
 
@@ -69,6 +69,13 @@ SOFT_WORDS = {
                    + _COPY,
     "float16": "drawn at the soft body's nodes rounded to float16 (half precision: 11 bits, a millimetre at two "
                "metres): keep the vertices in float32 or float64; " + _COPY,
+    "soft-posed": "drawn at the soft body's nodes moved again by the body's pose (getBasePositionAndOrientation, as "
+                  "the rigid bodies' code poses their actors, given to the soft body's actor too): the nodes are "
+                  "already in the world's frame; leave a soft body's actor at the identity pose and " + _COPY,
+    "rigid-or-posed": "{name} is a soft body drawn at its pose (getBasePositionAndOrientation) applied to its nodes "
+                      "as they are now, which are also its vertices as built: posed as if rigid, or its nodes moved "
+                      "again by that pose, which a frame where it has changed shape tells apart; a soft body's "
+                      "vertices are its nodes as they are: " + _COPY,
     "visual-mesh": "drawn at the soft body's visual mesh (getMeshData without MESH_DATA_SIMULATION_MESH: one vertex "
                    "per corner of each face, {corners} of them, not the {count} nodes in order): " + _COPY,
     "every-node": "vertex k is drawn at node k, the first {drawn} of the body's {count} nodes: this soft body is "
@@ -293,12 +300,19 @@ def _explain_soft(run, drawn: Drawn, tolerance: float) -> tuple[str, str] | None
     found = _soft_partly(drawn, truth_vertices, candidates, allowance)
     if found:
         return found
-    for position, matrix in (drawn.physics.rigid_poses or {}).get(i, ()):  # its vertices rewritten at a rigid pose
-        expected = built @ matrix.T + position
-        if np.max(np.linalg.norm(expected - truth_vertices, axis=1)) <= DISTINCT * allowance:
-            continue
-        if np.max(np.linalg.norm(expected - drawn.vertices, axis=1)) <= allowance:
+    for position, matrix in (drawn.physics.rigid_poses or {}).get(i, ()):
+        # its built vertices rewritten at the body's rigid pose, or its nodes moved again by it: alike until
+        # the body deforms (at frame 0 the nodes are the built vertices)
+        fits = [name for name, expected in (("drawn-as-rigid", built @ matrix.T + position),
+                                            ("soft-posed", truth_vertices @ matrix.T + position))
+                if np.max(np.linalg.norm(expected - truth_vertices, axis=1)) > DISTINCT * allowance
+                and np.max(np.linalg.norm(expected - drawn.vertices, axis=1)) <= allowance]
+        if len(fits) == 2:
+            return "rigid-or-posed", "diagnosis: " + SOFT_WORDS["rigid-or-posed"].format(name=repr(t.name))
+        if fits == ["drawn-as-rigid"]:
             return "drawn-as-rigid", _as_rigid(t, "posed")
+        if fits:
+            return "soft-posed", "diagnosis: " + SOFT_WORDS["soft-posed"]
     if len(now) > len(t.nodes) and not np.array_equal(t.nodes, np.arange(len(t.nodes))):
         # a volumetric body drawn as if every node were drawn, in order (a sync written for surfaces)
         expected = now[:len(t.nodes)]
@@ -355,6 +369,20 @@ def _soft_partly(drawn: Drawn, truth_vertices, candidates, allowance: float) -> 
             np.max(np.linalg.norm(drawn.vertices - half, axis=1)) <= allowance:
         return "float16", "diagnosis: " + SOFT_WORDS["float16"]
     return None
+
+
+#: The names of a soft body's drawing that two mistakes draw alike at one frame, and the two; a later frame
+#: tells them apart (:func:`undecided`)
+UNDECIDED = {"late-or-once": ("previous-step", "never-moved"), "rigid-or-posed": ("drawn-as-rigid", "soft-posed")}
+
+
+def undecided(found: tuple[str, str] | None, frame: int) -> tuple[str, str] | None:
+    """The two mistakes ``found`` (an :func:`explain` result at ``frame``) cannot tell apart yet, or None."""
+    if not found:
+        return None
+    if found[1] == late_or_once(frame):
+        return UNDECIDED["late-or-once"]
+    return UNDECIDED.get(found[0])
 
 
 def late_or_once(frame: int) -> str:
