@@ -3,6 +3,8 @@ drawing and fails, with the right diagnosis, on a drawing with one known mistake
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
@@ -636,3 +638,90 @@ def test_a_drawing_far_from_its_shape_and_on_no_other_names_no_other_body():
     verdicts = judge(recording([box_frame(0), box_frame(1)], [a, b], [track(drawn), track(draw(*b), label="other")]))
     assert "placed" in _failing(verdicts) and "reaches" in verdicts["placed"].message(), verdicts["placed"].message()
     assert verdicts["placed"].diagnoses == [], verdicts["placed"].message()
+
+
+def test_a_mesh_scaled_about_its_own_origin_is_named_scaled():
+    """A mesh whose file puts its origin at a corner (pybullet_data's lego brick: its visual frame at
+    (-0.016, -0.016, -0.0115)), its scale applied twice to its vertices: every part 1.6 times too large about
+    that origin, so its centre is off both the link frame's scaled one and its own. ``placed`` names ``scaled``
+    with the factor; the same drawing moved off that place as well is not a scale alone and is not so named."""
+    pos, orn = motion()
+    corner = -HALF
+    box = box_frame()
+    mesh = dataclasses.replace(box, visuals=(("mesh", (1.0, 1.0, 1.0), tuple(corner), (0.0, 0.0, 0.0, 1.0),
+                                              tuple(map(tuple, CORNERS - corner))),))
+    scaled = corner + 1.6 * (CORNERS - corner)
+    verdicts = judge(recording([mesh], [(pos, orn)], [track(draw(pos, orn, scaled))]))
+    assert verdicts["placed"].diagnoses == ["scaled"] and "1.6 times" in verdicts["placed"].message(), \
+        verdicts["placed"].message()
+    moved = judge(recording([mesh], [(pos, orn)], [track(draw(pos, orn, scaled + [1.0, 0.0, 0.0]))]))
+    assert "scaled" not in moved["placed"].diagnoses, moved["placed"].message()
+
+
+def test_a_drawing_off_its_shape_onto_another_of_another_size_names_no_other_body():
+    """``other-body`` needs the part drawn off its frame's shape to *be* the other frame's shape: lying on it at
+    the first tick and of its size. A drawing that lies on a bigger neighbour (a gripper's base drawn turned over
+    onto its fingers) is not that neighbour's drawing; the same part at that neighbour's size is."""
+    a, b = motion(seed=1), motion(seed=2, offset=(1.0, 0.0, 0.0))
+    big = Frame(0, 1, -1, "box1", 1.0, (("box", tuple(6 * HALF), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0)),), (0.0, 0.0, 0.0))
+    offset = Rotation.from_quat(a[1][0]).inv().apply(b[0][0] - a[0][0])
+    drawn = np.concatenate([draw(*a), draw(*a, CORNERS + offset)], axis=1)
+    small = judge(recording([box_frame(0), big], [a, b], [track(drawn), track(draw(*b, 3 * CORNERS), label="big")]))
+    assert "placed" in _failing(small) and small["placed"].diagnoses == [], small["placed"].message()
+    same = judge(recording([box_frame(0), big], [a, b], [track(np.concatenate([draw(*a), draw(*a, 3 * CORNERS + offset)],
+                                                                                axis=1)),
+                                                         track(draw(*b, 3 * CORNERS), label="big")]))
+    assert same["placed"].diagnoses == ["other-body"], same["placed"].message()
+
+
+def test_a_constant_turn_on_a_link_that_never_turns_names_neither_the_turn_nor_the_shape():
+    """A link that only slides, drawn with its quaternion reordered (w, x, y, z): one constant wrong turn, which
+    is also what a shape turned in its frame draws. ``placed`` fails it and names nothing; the same drawing
+    on a link that turns is ``attached``'s, named there."""
+    pos, _ = motion()
+    q = Rotation.from_euler("z", 90, degrees=True).as_quat()
+    orn = np.tile(q, (len(pos), 1))
+    verdicts = judge(recording([box_frame()], [(pos, orn)], [track(draw(pos, np.roll(orn, 1, axis=1)))]))
+    assert "placed" in _failing(verdicts) and "attached" not in _failing(verdicts), verdicts["placed"].message()
+    assert verdicts["placed"].diagnoses == [], verdicts["placed"].message()
+    # the same turn inside the frame on a link that turns: a shape turned in its frame, named so
+    pos, orn = motion()
+    turn = Rotation.from_quat(q).inv() * Rotation.from_quat(np.roll(q, 1))
+    turned = judge(recording([box_frame()], [(pos, orn)], [track(draw(pos, orn, turn.apply(CORNERS)))]))
+    assert turned["placed"].diagnoses == ["turned-shape"], turned["placed"].message()
+
+
+def test_a_link_left_where_it_was_built_inside_a_still_ground_is_not_the_ground_drawn_small():
+    """A link never synced, left where it was built, sunk in a ground box that never moves: the ground holds
+    what never moves and lies on it, so its vertices look like the ground drawn at a tenth of its size. `drawn`
+    names the link left behind; `placed` still fails what the ground holds but names no scale (issue 48)."""
+    ground = dataclasses.replace(box_frame(0), mass=0.0, shapes=(("box", (2.0, 4.0, 0.5), (0.0, 0.0, -0.25),
+                                                                      (0.0, 0.0, 0.0, 1.0)),))
+    still = (np.zeros((TICKS + 1, 3)), np.tile([0.0, 0.0, 0.0, 1.0], (TICKS + 1, 1)))
+    link = motion(seed=3, offset=(0.0, 0.0, -2.025))
+    flat = CORNERS * np.array([1.0, 1.0, 0.5]) + [0.0, 0.0, -0.025]
+    left = np.broadcast_to(flat, (TICKS + 1, 8, 3)).copy()
+    verdicts = judge(recording([ground, box_frame(1)], [still, link], [track(left)]))
+    assert verdicts["drawn"].diagnoses == ["never-moved"], verdicts["drawn"].message()
+    assert "placed" in _failing(verdicts) and "scaled" not in verdicts["placed"].diagnoses, verdicts["placed"].message()
+
+
+def test_a_drawing_at_a_turned_centre_of_mass_frame_is_named_com_frame_unless_a_visual_frame_draws_it_alike():
+    """A link whose centre-of-mass frame is turned (pybullet_data's bicycle: <inertial rpy="1.57 0 0">) drawn at
+    that frame: the shape moved and turned by getDynamicsInfo(...)[3:5], named ``com-frame``. Where its visual
+    frame is that same turn (the bicycle's frame link), leaving the visual frame out draws the same vertices, and
+    neither is named (issue 48: right or silent)."""
+    pos, orn = motion()
+    turn = Rotation.from_euler("x", 90, degrees=True)
+    com_pos = np.array([0.0, 0.0, 0.3])
+    frame = dataclasses.replace(box_frame(), inertial=tuple(com_pos), inertial_turn=tuple(turn.as_quat()))
+    at_com = com_pos + turn.apply(CORNERS)
+    verdicts = judge(recording([frame], [(pos, orn)], [track(draw(pos, orn, at_com))]))
+    assert verdicts["placed"].diagnoses == ["com-frame"], verdicts["placed"].message()
+    # the visual shape in a visual frame turned as the centre-of-mass frame is: the box turned twice (a half turn,
+    # which leaves a centred box as it was) or not at all is the same box, so either mistake draws it
+    visual = dataclasses.replace(frame, inertial=(0.0, 0.0, 0.0), shapes=(),
+                                 visuals=(("box", tuple(2 * HALF), (0.0, 0.0, 0.0), tuple(turn.as_quat()),
+                                           tuple(map(tuple, CORNERS))),))
+    alike = judge(recording([visual], [(pos, orn)], [track(draw(pos, orn))]))
+    assert "placed" in _failing(alike) and alike["placed"].diagnoses == [], alike["placed"].message()

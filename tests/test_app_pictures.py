@@ -10,8 +10,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
-from app_recordings import CORNERS, box_frame, draw, motion, recording, track
+from app_recordings import CORNERS, HALF, box_frame, draw, motion, recording, track
 from conformance import apps, backends
 from conformance.apps import judge, recording as recording_mod
 from conformance.apps.bodies import Frame
@@ -133,14 +134,26 @@ def test_pixels_of_a_frame_the_kit_does_not_judge_are_left_out():
 
 
 def test_a_body_drawn_only_as_another_shape_is_held_to_pyBullets_picture():
-    """Every drawing of the box is half its size (FURY 0.12's own chain demo draws its 1 m discs as thin
-    rods): placed cannot judge it, but the picture must still show what pyBullet simulates."""
+    """Every drawing of the box is flattened to half its height (FURY 0.12's own chain demo draws its 1 m discs
+    as thin rods): placed cannot judge it, but the picture must still show what pyBullet simulates."""
+    pos, orn = motion()
+    flat = [track(draw(pos, orn, CORNERS * np.array([1.0, 1.0, 0.5])))]
+    verdict = _judged([_shot(_labels(_square(top=15, left=15, side=10), 0), _labels(_square(), 0))], tracks=flat)
+    assert not verdict.passed and verdict.diagnoses == ["not-its-shape"], verdict.message()
+    drawn_right = _judged([_shot(_labels(_square(), 0), _labels(_square(), 0))], tracks=flat)
+    assert drawn_right.passed, drawn_right.message()
+
+
+def test_a_body_drawn_at_another_size_is_named_by_placed_not_by_its_picture():
+    """The box drawn at half its size, every axis alike (a globalScaling applied twice): placed names it
+    ``scaled`` with the factor, and the picture, which that explains, names no other shape (issue 48)."""
     pos, orn = motion()
     small = [track(draw(pos, orn, CORNERS / 2))]
-    verdict = _judged([_shot(_labels(_square(top=15, left=15, side=10), 0), _labels(_square(), 0))], tracks=small)
-    assert not verdict.passed and verdict.diagnoses == ["not-its-shape"], verdict.message()
-    drawn_right = _judged([_shot(_labels(_square(), 0), _labels(_square(), 0))], tracks=small)
-    assert drawn_right.passed, drawn_right.message()
+    r = recording([box_frame()], [(pos, orn)], small)
+    r.pictures = [_shot(_labels(_square(top=15, left=15, side=10), 0), _labels(_square(), 0))]
+    verdicts = judge(r)
+    assert verdicts["placed"].diagnoses == ["scaled"] and "0.5 times" in verdicts["placed"].message()
+    assert not verdicts["pictured"].passed and verdicts["pictured"].diagnoses == [], verdicts["pictured"].message()
 
 
 def test_a_decoration_beside_a_drawing_of_the_shape_leaves_the_body_out_of_the_picture():
@@ -367,3 +380,30 @@ def test_a_face_fury_shows_from_its_back_where_pybullet_shows_nothing_is_left_ou
     shot = {"fury_depth": np.where(_square(), 1.0, np.inf), "bullet_depth": np.full(fury.shape, np.inf),
             "bullet": bullet, "fury_back": _square() & back}
     assert pictured.undecided(shot, fury, bullet, background=set())[_square()].all() == left_out
+
+
+def test_a_body_welded_to_a_link_not_drawn_names_no_other_shape():
+    """A base and a link on a fixed joint are one rigid drawing (:mod:`conformance.apps.welds`): with the link
+    drawn nowhere (``drawn`` says so), what the base's actor shows may be part of the link's drawing, so its
+    failing picture names no other shape; the same base alone does (issue 48: right or silent)."""
+    pos, orn = motion()
+    link = Frame(0, 0, 0, "box0 link", 1.0, (("box", tuple(2 * HALF), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0)),))
+    link_pos = pos + Rotation.from_quat(orn).apply([0.5, 0.0, 0.0])
+    flat = [track(draw(pos, orn, CORNERS * np.array([1.0, 1.0, 0.5])))]
+    shots = [_shot(_labels(_square(top=15, left=15, side=10), 0), _labels(_square(), 0))]
+    welded = _judged(shots, frames=[box_frame(), link], poses=[(pos, orn), (link_pos, orn)], tracks=flat)
+    assert not welded.passed and welded.diagnoses == [], welded.message()
+    alone = _judged(shots, tracks=flat)
+    assert not alone.passed and alone.diagnoses == ["not-its-shape"], alone.message()
+
+
+def test_a_body_that_never_moves_drawn_as_another_shape_names_no_shape():
+    """A fixed base (mass, but its pose constant for the whole run) drawn flattened: every still frame holds what
+    never moves alike, so the part of the drawing it holds is no evidence of the shape drawn. Its picture fails
+    and names nothing; the same body moving names ``not-its-shape`` (the test above)."""
+    pos, orn = motion()
+    fixed = (np.broadcast_to(pos[0], pos.shape).copy(), np.broadcast_to(orn[0], orn.shape).copy())
+    flat = [track(draw(*fixed, CORNERS * np.array([1.0, 1.0, 0.5])))]
+    shots = [_shot(_labels(_square(top=15, left=15, side=10), 0), _labels(_square(), 0))]
+    verdict = _judged(shots, poses=[fixed], tracks=flat)
+    assert not verdict.passed and verdict.diagnoses == [], verdict.message()

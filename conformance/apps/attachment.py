@@ -33,7 +33,8 @@ from scipy.spatial.transform import Rotation
 from conformance.bullet import poses
 from conformance.judge.tolerances import DEFAULT, Tolerance
 
-__all__ = ["ALIASES", "Attachment", "TURNS", "VARIANTS", "attach", "in_frame", "local_coordinates", "variant_fit", "visual_order"]
+__all__ = ["ALIASES", "Attachment", "TURNS", "VARIANTS", "attach", "bad_ticks", "in_frame", "local_coordinates", "rotations", "runs",
+           "variant_fit", "visual_order"]
 
 #: nearest frames (by origin, at the first judged tick) tried first for each vertex, then more of
 #: them for a vertex none of those holds, then all of them (so a range following a far body is found)
@@ -458,7 +459,8 @@ def _vtk_euler(quaternions: np.ndarray) -> np.ndarray:
     return poses.euler_matrices(quaternions, "ZXY", (2, 0, 1))
 
 
-def _rotations(quaternions: np.ndarray) -> np.ndarray:
+def rotations(quaternions: np.ndarray) -> np.ndarray:
+    """The rotation matrices ``(..., 3, 3)`` of pyBullet's quaternions ``(..., 4)`` (x, y, z, w)."""
     return Rotation.from_quat(quaternions.reshape(-1, 4)).as_matrix().reshape(quaternions.shape[:-1] + (3, 3))
 
 
@@ -515,17 +517,17 @@ VARIANTS = {
     "previous-step": ("drawn exactly at pyBullet's pose of the previous step (or of the previous tick, where a tick "
                       "steps several times): sync after p.stepSimulation(), and read links with getLinkState(..., "
                       "computeForwardKinematics=1)",
-                      lambda p, q, bp, bq: (bp, _rotations(bq))),
+                      lambda p, q, bp, bq: (bp, rotations(bq))),
     "conjugate": ("drawn with the inverse (conjugate, or transposed-matrix) rotation: a row-vector `v @ R` where "
                   "`R @ v` was meant, or a matrix written transposed",
-                  lambda p, q, bp, bq: (p, np.swapaxes(_rotations(q), -1, -2))),
+                  lambda p, q, bp, bq: (p, np.swapaxes(rotations(q), -1, -2))),
     "wxyz": ("drawn with the quaternion reordered to (w, x, y, z) and handed to something that takes pyBullet's "
              "(x, y, z, w): scipy's Rotation.from_quat (unless scalar_first=True), pygfx's local.rotation, pyBullet's "
              "own calls: pass pyBullet's quaternion as it is",
-             lambda p, q, bp, bq: (p, _rotations(np.roll(q, 1, axis=-1)))),
+             lambda p, q, bp, bq: (p, rotations(np.roll(q, 1, axis=-1)))),
     "scalar-first": ("drawn with pyBullet's (x, y, z, w) quaternion read as (w, x, y, z) (scalar first: transforms3d, "
                      "Eigen, scipy's scalar_first=True): read it as (x, y, z, w)",
-                     lambda p, q, bp, bq: (p, _rotations(np.roll(q, -1, axis=-1)))),
+                     lambda p, q, bp, bq: (p, rotations(np.roll(q, -1, axis=-1)))),
     "euler-order": ("drawn with pyBullet's Euler angles applied in VTK's order (SetOrientation turns about z, then x, "
                     "then y; getEulerFromQuaternion's angles are about fixed x, y, z): set a matrix from the quaternion",
                     lambda p, q, bp, bq: (p, _vtk_euler(q))),
@@ -540,12 +542,12 @@ VARIANTS = {
     # degrees=True)): each angle shrunk, not the turn's one angle, which parts from the above past small turns.
     "radians-as-degrees, Euler": ("", lambda p, q, bp, bq: (p, _euler_as_degrees(q))),
     # A visual shape's frame composed the wrong way round with its link's (visual @ link): it depends on each
-    # frame's visual frame, which these poses do not hold, so the judgement makes it (judge._variants); here
+    # frame's visual frame, which these poses do not hold, so the judgement makes it (naming.Naming._variants); here
     # the link's own pose stands in, which explains nothing.
-    "visual-frame, order": ("", lambda p, q, bp, bq: (p, _rotations(q))),
+    "visual-frame, order": ("", lambda p, q, bp, bq: (p, rotations(q))),
     # Drawn a tick late where a tick steps several times (the pose at the end of the previous tick, before the
-    # tick's first step): made by the judgement from the recording's ticks (judge._variants), as above.
-    "previous-step, tick": ("", lambda p, q, bp, bq: (p, _rotations(q))),
+    # tick's first step): made by the judgement from the recording's ticks (naming.Naming._variants), as above.
+    "previous-step, tick": ("", lambda p, q, bp, bq: (p, rotations(q))),
     "float32-angle-axis": ("turned by pyBullet's getAxisAngleFromQuaternion, which computes in float32: an angle of "
                            "0.001 rad comes back as 0.0009765625, and below about 0.002 rad the axis is (1, 0, 0): "
                            "build the rotation from the quaternion (getMatrixFromQuaternion, scipy's Rotation.from_quat)",
@@ -555,7 +557,7 @@ VARIANTS = {
 
 #: Variants that are another form of a mistake named before them: the name a diagnosis gives them.
 #: The variants that differ from pyBullet's pose by the rotation alone: more than one of them can hold one
-#: drawing (:meth:`conformance.apps.judge._Judgement._turn_on_its_shape` tells them apart)
+#: drawing (:meth:`conformance.apps.naming.Naming._turn_on_its_shape` tells them apart)
 TURNS = ("conjugate", "wxyz", "scalar-first", "euler-order", "translation-only", "radians-as-degrees",
          "radians-as-degrees, Euler", "float32-angle-axis")
 
@@ -619,3 +621,20 @@ def variant_fit(vertices: np.ndarray, positions: np.ndarray, rotations: np.ndarr
         if np.all(np.linalg.norm(local - ref, axis=-1) <= allowance):
             return True
     return False
+
+
+def bad_ticks(error: np.ndarray, allowance: np.ndarray) -> np.ndarray:
+    """The ticks (indices) at which some vertex's error ``(m, T)`` is beyond its allowance ``(m,)``."""
+    return np.flatnonzero(np.any(error > allowance[:, None], axis=0))
+
+
+def runs(mask: np.ndarray, frames: np.ndarray):
+    """``(start, stop)`` of each run of consecutive true entries of ``mask`` with one frame."""
+    start = None
+    for i in range(len(mask) + 1):
+        boundary = i == len(mask) or not mask[i] or (start is not None and frames[i] != frames[start])
+        if start is not None and boundary:
+            yield start, i
+            start = None
+        if i < len(mask) and mask[i] and start is None:
+            start = i

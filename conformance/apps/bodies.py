@@ -67,6 +67,9 @@ class Frame:
     #: alpha 0); -1 where unknown (a recording made before the kit counted them). A frame pyBullet draws none of
     #: need not be drawn (:func:`conformance.apps.judge._shown`)
     shown: int = -1
+    #: the centre-of-mass frame's turn in the link frame (``getDynamicsInfo()[4]``): a drawing made at the centre
+    #: of mass is turned by it too (a bicycle's frame: its <inertial> turned 90° about x)
+    inertial_turn: tuple = (0.0, 0.0, 0.0, 1.0)
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -314,7 +317,8 @@ def frames_of(clients, notes: list | None = None) -> list[Frame]:
         for link, name, info, shapes, mesh in read.links:
             shapes = _shapes(info, shapes)
             frames.append(Frame(read.client, read.body, link, name, float(info[0]), shapes, tuple(info[3]),
-                                _mesh(info, mesh), visuals.get(link, ()), shown=-1 if unknown else shown.get(link, 0)))
+                                _mesh(info, mesh), visuals.get(link, ()), shown=-1 if unknown else shown.get(link, 0),
+                                inertial_turn=tuple(info[4])))
     return frames
 
 

@@ -342,6 +342,7 @@ def check(judgement):
                or (not r.frames[i].visuals and r.frames[i].shapes and r.frames[i].shapes[0][0] in ("sphere", "cylinder"))}
     worst = None
     decorations = _decorations(judgement, unlike)
+    drawn_wrong = judgement.drawn_wrong() | judgement.still
     for shot in r.pictures:
         if "skipped" in shot:
             verdict.notes.append(f"no picture at tick {shot['tick']}: {shot['skipped']}")
@@ -378,10 +379,12 @@ def check(judgement):
             own = members.get(t["index"], [t["index"]])
             # A soft body whose vertices all follow their nodes (attached, drawn and placed found none
             # wrong) yet whose picture is not pyBullet's: its triangles join other nodes.
-            # A frame `attached` found drawn at a wrong pose is not pictured as its shape for that reason: its
-            # picture is not evidence of the shape drawn.
+            # A frame `attached` found drawn at a wrong pose, `drawn` not drawn, or `placed` off its shape or at another
+            # size, is not pictured as its shape for that reason: its picture is not evidence of another shape drawn.
+            # Nor is one that never moves: what it holds, every still frame holds alike (a fixed base drawn turned
+            # over, its vertices shared out between it and the ground).
             return (_diagnosis(own, shot, r, judgement.attachments)
-                    or ("not-its-shape" if t["index"] in unlike and t["index"] not in judgement.followed_badly else "")
+                    or ("not-its-shape" if t["index"] in unlike and t["index"] not in drawn_wrong else "")
                     or ("face-order" if t["index"] in members and _triangles_to_blame(judgement, t["index"]) else ""))
         verdict.pictures.append((record, silhouettes.mask_images(fury, bullet) if failing else {}))
         explained: dict[str, int] = {}

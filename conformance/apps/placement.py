@@ -238,12 +238,13 @@ def _mistakes(visuals) -> list[tuple[str, np.ndarray, np.ndarray]]:
 
 
 def place(reference: np.ndarray, shapes, inertial_position, *, tolerance: Tolerance = DEFAULT, mesh=(),
-          visuals=()) -> Placement:
+          visuals=(), inertial_turn=(0.0, 0.0, 0.0, 1.0)) -> Placement:
     """Judge the link-frame coordinates ``reference`` ``(m, 3)`` of the vertices one frame holds in one
     actor against the frame's shapes (:func:`candidates`: its collision shape, its visual shapes as
     ``getVisualShapeData`` holds them, with their local frames and scales); ``inertial_position`` is the
     centre of mass in the link frame (``getDynamicsInfo(body, link)[3]``), to recognise a drawing made at
-    the centre of mass, or with its offset the wrong way."""
+    the centre of mass, or with its offset the wrong way; ``inertial_turn`` the centre-of-mass frame's turn
+    (``[4]``), which turns such a drawing too."""
     shapes_of = candidates(shapes, mesh, visuals)
     if not shapes_of:
         kinds = ", ".join(s[0] for s in shapes) or "none"
@@ -295,13 +296,22 @@ def place(reference: np.ndarray, shapes, inertial_position, *, tolerance: Tolera
         return Placement(True, False, f"drawn {np.linalg.norm(offset):.4g} m off {what} (drawn centre "
                          f"{_v(drawn_centre)} in the link frame, the shape's {_v(centre)}; allowed {slack[axis]:.3g} m "
                          f"along {'xyz'[axis]})", offset, diagnosis, which)
+    # A drawing made at the centre of mass is the shape moved and turned by the centre-of-mass frame; where that
+    # frame is turned (a bicycle's), what it draws may also be what a visual frame left out draws: then neither.
+    at_com = _at_turned_com(drawn_centre, drawn_half, shapes_of, inertial_position, inertial_turn, allowance)
     for mistake, m_centre, m_half, factor in _mistakes(visuals):
         room = allowance(m_half)
         if np.all(np.abs(m_half - drawn_half) <= room) and np.all(np.abs(m_centre - drawn_centre) <= room):
             how = (_MISTAKEN[mistake] if not factor else f"at {1 / factor:.4g} times its size: its mesh scale {factor:.4g} "
                    "(getVisualShapeData(...)[3], which holds loadURDF's globalScaling) left out")
+            if at_com:
+                how += ", or at its centre-of-mass frame (getDynamicsInfo(...)[3:5]), which draws it alike"
             return Placement(True, False, f"drawn as its visual shape {how} (half extents {_v(drawn_half)}, "
-                             f"centre {_v(drawn_centre)} in the link frame)", drawn_centre, mistake, "visual")
+                             f"centre {_v(drawn_centre)} in the link frame)", drawn_centre, "" if at_com else mistake, "visual")
+    if at_com:
+        return Placement(True, False, f"drawn at its centre-of-mass frame, moved and turned by getDynamicsInfo(...)[3:5] "
+                         f"(half extents {_v(drawn_half)}, centre {_v(drawn_centre)} in the link frame)", drawn_centre,
+                         "com-frame", at_com)
     for what, which, centre, half in shapes_of:
         if np.all(np.abs(np.sort(drawn_half) - np.sort(half)) <= allowance(half)):
             return Placement(True, False, f"drawn turned in its frame: half extents {_v(drawn_half)} in the link frame's "
@@ -310,9 +320,10 @@ def place(reference: np.ndarray, shapes, inertial_position, *, tolerance: Tolera
     for what, which, centre, half in shapes_of:
         scale = _uniform_scale(drawn_half, half, tolerance.bounds_rtol)
         room = allowance(scale * half) if scale else 0.0
-        # Scaled about the link frame (a globalScaling applied twice scales the visual frame's offset too) or
-        # about the shape's centre (a mesh scale left out).
-        if scale and any(np.all(np.abs(drawn_centre - c) <= room) for c in (scale * centre, centre)):
+        # Scaled about the link frame (a globalScaling applied twice scales the visual frame's offset too), about
+        # the shape's centre, or about a visual mesh's own origin, where its file puts it (a lego brick's at a
+        # corner: its scale applied twice to the vertices moves the brick's centre off both).
+        if scale and _scaled_about(drawn_centre, centre, scale, room, [v[2] for v in visuals]):
             return Placement(False, True, f"not judged: drawn at {scale:.3g} times the size of {what} (half extents "
                              f"{_v(drawn_half)} where the shape's are {_v(half)})", drawn_centre - centre, "scaled", which, scale)
     what, which, centre, half = shapes_of[0]
@@ -325,6 +336,33 @@ def place(reference: np.ndarray, shapes, inertial_position, *, tolerance: Tolera
     known = "; ".join(f"{what}, half extents {_v(half)}" for what, _, _, half in shapes_of)
     return Placement(False, True, f"not judged: the drawn shape (half extents {_v(drawn_half)}) is none of the frame's "
                      f"shapes ({known})")
+
+
+def _at_turned_com(drawn_centre, drawn_half, shapes_of, inertial_position, inertial_turn, allowance) -> str:
+    """Which of the shapes (``"visual"``, ``"collision"``; "" none) the drawing is, drawn in a turned
+    centre-of-mass frame (``p_i + R_i x`` for its points ``x`` in the link frame): the box of that shape's box so
+    moved and turned. "" when the centre-of-mass frame is not turned (the sized shapes' test covers it)."""
+    turn = Rotation.from_quat(np.asarray(inertial_turn, dtype=np.float64))
+    if turn.magnitude() <= 1e-6:
+        return ""
+    matrix = np.abs(turn.as_matrix())
+    for _, which, centre, half in shapes_of:
+        com_centre = np.asarray(inertial_position, dtype=np.float64) + turn.apply(centre)
+        com_half = matrix @ half  # the box of a box turned
+        room = allowance(com_half)
+        if np.all(np.abs(com_half - drawn_half) <= room) and np.all(np.abs(com_centre - drawn_centre) <= room):
+            return which
+    return ""
+
+
+def _scaled_about(drawn_centre: np.ndarray, centre: np.ndarray, scale: float, room: float, origins=()) -> bool:
+    """Whether a drawing whose box is centred at ``drawn_centre`` is a shape (centre ``centre``) scaled by ``scale``
+    about the link frame's origin, the shape's centre, or one of ``origins`` (its visual shapes' own origins in
+    the link frame, about which a mesh file's vertices are scaled)."""
+    if np.all(np.abs(drawn_centre - scale * centre) <= room):
+        return True
+    return any(np.all(np.abs(drawn_centre - (o + scale * (centre - o))) <= room)
+               for o in (centre, *(np.asarray(o, dtype=np.float64) for o in origins)))
 
 
 def _uniform_scale(drawn_half: np.ndarray, half: np.ndarray, rtol: float) -> float:

@@ -127,7 +127,7 @@ def _frame(d: dict) -> Frame:
     return Frame(d["client"], d["body"], d["link"], d["name"], d["mass"], shapes, tuple(d.get("inertial", (0.0, 0.0, 0.0))),
                  tuple(tuple(v) for v in d.get("mesh", ())),
                  tuple((v[0], tuple(v[1]), tuple(v[2]), tuple(v[3]), tuple(tuple(q) for q in v[4])) for v in d.get("visuals", ())), d.get("node", -1),
-                 d.get("shown", -1))
+                 d.get("shown", -1), tuple(d.get("inertial_turn", (0.0, 0.0, 0.0, 1.0))))
 
 
 def load(path) -> Recording:

@@ -17,6 +17,8 @@ from collections import Counter, defaultdict
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from conformance.judge.ties import UNDECIDED  # names of two mistakes at once: none of the two, and neither wrong
+
 __all__ = ["CORPORA", "UNDECIDED", "Case", "cell", "load", "markdown", "record", "save", "worse"]
 
 #: The corpora, in the order the page shows them, and what each is.
@@ -47,10 +49,7 @@ class Case:
         return cell(self.expected, self.named)
 
 
-#: Names that say two mistakes cannot be told apart yet: none of the two is named, and neither is wrong.
-UNDECIDED = {"late-or-once": {"previous-step", "never-moved"},
-             "rigid-or-posed": {"drawn-as-rigid", "soft-posed"},
-             "late-or-own-move": {"previous-step", "before-own-move"}}
+
 
 
 def cell(expected: str, named: str) -> str:

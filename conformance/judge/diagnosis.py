@@ -24,6 +24,7 @@ import numpy as np
 import pybullet
 
 from conformance.bullet import poses, truth
+from conformance.judge.ties import UNDECIDED  # a later frame tells each pair apart (undecided)
 
 __all__ = ["EULER_ORDERS", "MISTAKES", "NORMAL_MISTAKES", "SOFT_WORDS", "UNDECIDED", "Drawn", "diagnose", "diagnose_frame",
            "diagnose_normals", "diagnose_problems", "drawn_now", "explain", "explain_failures", "explain_frame",
@@ -371,9 +372,6 @@ def _soft_partly(drawn: Drawn, truth_vertices, candidates, allowance: float) -> 
     return None
 
 
-#: The names of a soft body's drawing that two mistakes draw alike at one frame, and the two; a later frame
-#: tells them apart (:func:`undecided`)
-UNDECIDED = {"late-or-once": ("previous-step", "never-moved"), "rigid-or-posed": ("drawn-as-rigid", "soft-posed")}
 
 
 def undecided(found: tuple[str, str] | None, frame: int) -> tuple[str, str] | None:
