@@ -52,7 +52,8 @@ class _Judgement(Naming):
         self.rot = attach_mod.rotations(self.orn) if self.orn.size else np.zeros(self.orn.shape[:-1] + (3, 3))
         self.event_ticks = sorted({int(e["frame"]) - 1 for e in recording.events})
         self._distances: dict = {}  # frame -> its shape_distance, hulls computed once
-        spheres = [bounding_sphere(f.shapes, f.mesh) for f in recording.frames]
+        #: each frame's bounding sphere (centre in its link frame, radius): attachment's nearness, _radii's reach
+        self._spheres = spheres = [bounding_sphere(f.shapes, f.mesh) for f in recording.frames]
         centres = np.array([c for c, _ in spheres]).reshape(-1, 3)
         radii = np.array([r for _, r in spheres])
         #: frames welded together (fixed joints): one rigid frame, whose vertices go to the member they lie on
@@ -121,7 +122,7 @@ class _Judgement(Naming):
         """How far each frame's collision shapes reach from its origin (0 for a frame without): a mesh's too (a
         Franka's links are meshes; measured by their box alone, every loose vertex of a link drawn with its
         quaternion reordered was diagnosed on its own, 12,847 pieces and most of the judgement's time)."""
-        reach = [float(np.linalg.norm(c)) + r for c, r in (bounding_sphere(f.shapes, f.mesh) for f in self.r.frames)]
+        reach = [float(np.linalg.norm(c)) + r for c, r in self._spheres]
         return np.array([max(bounding_radius(f.shapes), far) if f.shapes else 0.0 for f, far in zip(self.r.frames, reach)])
 
     def frame_label(self, index: int) -> str:
@@ -349,16 +350,14 @@ class _Judgement(Naming):
                 distance = float(np.linalg.norm(points.mean(axis=0) - origin))
                 if distance <= radius + 0.01:
                     local = (points - origin) @ turn  # in the frame as it was at the start
-                    placed = place(local, info.shapes, self._inertial(index), tolerance=self.tolerance,
-                                   inertial_turn=info.inertial_turn, mesh=info.mesh, visuals=info.visuals)
+                    placed = self._place(local, index)
                     if placed.judged and placed.ok:
                         found.append((True, distance, f"{track.label} vertices {start}:{stop}", (k, start, stop)))
                         continue
                 # Built in the link frame and never posed: the world holds the frame's shape at its origin (a body
                 # that starts near the origin, a brick dropped from 3 cm, is near both); an actor per visual shape,
                 # built in the shape's own frame and posed by link @ visual, holds it there without its visual frame.
-                unposed = place(points, info.shapes, self._inertial(index), tolerance=self.tolerance,
-                                inertial_turn=info.inertial_turn, mesh=info.mesh, visuals=info.visuals)
+                unposed = self._place(points, index)
                 if unposed.judged and (unposed.ok or unposed.diagnosis == "visual-frame"):
                     found.append((True, distance, f"{track.label} vertices {start}:{stop} (at the world's origin, "
                                   "never posed)", (k, start, stop)))
@@ -392,10 +391,7 @@ class _Judgement(Naming):
                     rows = np.flatnonzero((a.frame == frame) & a.held)
                     if not len(rows):
                         continue
-                    info = self.r.frames[frame]
-                    result = place(_drawn_points(a.reference[rows], track.radii, rows), info.shapes,
-                                   self._inertial(frame), tolerance=self.tolerance, mesh=info.mesh, visuals=info.visuals,
-                                   inertial_turn=info.inertial_turn)
+                    result = self._place(_drawn_points(a.reference[rows], track.radii, rows), int(frame))
                     self._placements.append((track, a, int(frame), rows, result))
         return self._placements
 
@@ -422,8 +418,7 @@ class _Judgement(Naming):
                 rows = np.array([r for r in rows if r not in left], dtype=int)
                 if not len(rows):
                     continue  # `drawn` names them: the link left where it was built, not a drawing of this frame
-                result = place(_drawn_points(a.reference[rows], track.radii, rows), info.shapes, self._inertial(frame),
-                               tolerance=self.tolerance, mesh=info.mesh, visuals=info.visuals, inertial_turn=info.inertial_turn)
+                result = self._place(_drawn_points(a.reference[rows], track.radii, rows), frame)
             if info.node >= 0:
                 soft.setdefault((track.label, info.client, info.body, info.name), []).append(
                     (rows, frame, soft_bodies.off_node(self, a.reference[rows], frame)))
@@ -459,21 +454,22 @@ class _Judgement(Naming):
         orientation the run never changes (a gripper's base, a fixed robot's mount) a quaternion reordered turns
         the drawing by one constant turn, which is what a shape turned in its frame, or drawn without its visual
         frame, draws: the two cannot be told apart there."""
-        info = self.r.frames[frame]
         ticks = np.unique(np.linspace(0, len(self.pos) - 1, 3).astype(int))
         vertices = track.vertices[1:, rows][ticks]
         for name, (positions, rotations) in zip(attach_mod.VARIANTS, self._variants):
             if name not in attach_mod.TURNS:
                 continue
             local = attach_mod.local_coordinates(vertices, positions[ticks, frame, None], rotations[ticks, frame, None])
-            if all(_placed_on(place(_drawn_points(points, track.radii, rows), info.shapes, self._inertial(frame),
-                                    tolerance=self.tolerance, mesh=info.mesh, visuals=info.visuals,
-                                    inertial_turn=info.inertial_turn)) for points in local):
+            if all(result.judged and result.ok
+                   for result in (self._place(_drawn_points(points, track.radii, rows), frame) for points in local)):
                 return True
         return False
 
-    def _inertial(self, frame: int) -> np.ndarray:
-        return np.asarray(self.r.frames[frame].inertial, dtype=np.float64)
+    def _place(self, points: np.ndarray, frame: int):
+        """:func:`~conformance.apps.placement.place` of link-frame ``points`` against ``frame``'s shapes."""
+        info = self.r.frames[frame]
+        return place(points, info.shapes, np.asarray(info.inertial, dtype=np.float64), tolerance=self.tolerance,
+                     mesh=info.mesh, visuals=info.visuals, inertial_turn=info.inertial_turn)
 
     def normals(self) -> Verdict:
         verdict = Verdict("normals", True)
@@ -649,10 +645,6 @@ def _attach_finite(vertices: np.ndarray, bad: np.ndarray, *args, **kwargs):
         if good.welded is not None:
             found.welded[~bad] = good.welded
     return found
-
-
-def _placed_on(result) -> bool:
-    return result.judged and result.ok
 
 
 def _shown(frame) -> bool:
